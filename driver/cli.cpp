@@ -1,0 +1,127 @@
+// orchestrate's command line.
+#include "cli.h"
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+
+#include "config/case_config.h"
+#include "config/schema.h"
+#include "engine/runner.h"
+#include "pipeline.h"
+
+namespace mill {
+namespace fs = std::filesystem;
+
+std::string project_dir() {
+  if (const char* env = std::getenv("MILL_PROJECT_DIR")) return env;
+  return MILL_PROJECT_DIR;
+}
+
+namespace {
+
+const char* kExamples = R"(
+Stages, in order: flow, sample, transport, calibrate, breakage, report (or all).
+
+Examples:
+  orchestrate --stage all                        run everything on the default case
+  orchestrate --case cases/reference.yaml --stage all --dry-run
+                                                 show the plan: stages, jobs, what is done
+  orchestrate --stage breakage --jobs 2          two impact runs at once on this machine
+  orchestrate --stage flow --np 4                the CFD on 4 MPI ranks
+  orchestrate --stage breakage --list-tasks      one job per line (HPC array units)
+  orchestrate --stage breakage --task 7          run job 7 only (e.g. $SLURM_ARRAY_TASK_ID)
+  orchestrate --print-schema > docs/config.md    every case-file and ore-card key
+
+A rerun of the same command resumes: done jobs whose inputs did not change are
+skipped; failed, interrupted and changed ones are rerun (--force redoes all).
+Exit status: 0 ok, 1 a job failed, 2 bad input, 3 stage not implemented yet,
+128+N interrupted by signal N.
+)";
+
+}  // namespace
+
+int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{"orchestrate: beater-mill comminution workflow (OpenFOAM flow, LIGGGHTS transport and breakage)"};
+  app.footer(kExamples);
+  app.set_version_flag("--version", std::string("orchestrate ") + MILL_VERSION);
+
+  std::string case_file = (fs::path(project_dir()) / "cases" / "default.yaml").string();
+  std::string stage, output;
+  int np = 0, jobs = 0, task = -1;
+  bool dry_run = false, list_tasks = false, force = false, print_schema = false, check = false;
+  app.add_option("-c,--case", case_file, "Case file (YAML)")->capture_default_str();
+  app.add_option("-s,--stage", stage, "Stage to run: flow, sample, transport, calibrate, breakage, report, all");
+  app.add_option("-o,--output", output, "Run folder (default: runs/<case name>)");
+  app.add_option("--np", np, "MPI ranks per engine run (default: resources.np of the case)")->check(CLI::PositiveNumber);
+  app.add_option("-j,--jobs", jobs, "Engine runs at once on this machine (default: resources.jobs)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("-n,--dry-run", dry_run, "Print the plan (stages, jobs, which are done); run nothing");
+  app.add_flag("--list-tasks", list_tasks, "List the jobs of the stage, one per line: index, label, state, summary");
+  app.add_option("--task", task, "Run only job I (0-based) of the stage: one HPC array task")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("-f,--force", force, "Redo jobs that are already done");
+  app.add_flag("--print-schema", print_schema, "Print every case-file and ore-card key as Markdown");
+  app.add_flag("--check", check, "Validate the case file and its ore card, then exit");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    out << app.help();
+    return 0;
+  } catch (const CLI::CallForVersion& e) {
+    out << e.what() << "\n";
+    return 0;
+  } catch (const CLI::ParseError& e) {
+    err << "error: " << e.what() << "\nRun 'orchestrate --help' for the options.\n";
+    return kExitBadInput;
+  }
+
+  if (print_schema) {
+    out << config::schema_markdown();
+    return 0;
+  }
+  try {
+    const auto cfg = config::load_case(case_file, project_dir());
+    if (check) {
+      out << fmt::format("{}: case '{}' is valid; ore card {} ({})\n", cfg.file.string(), cfg.name,
+                         cfg.ore_file.string(), cfg.ore.str("name"));
+      return 0;
+    }
+    if (stage.empty()) {
+      err << "error: --stage: which stage? expected one of flow, sample, transport, calibrate, breakage, report, all\n"
+          << "Run 'orchestrate --help' for examples.\n";
+      return kExitBadInput;
+    }
+    Invocation inv;
+    inv.stages = resolve_stages(stage);
+    inv.opts.output = output.empty() ? fs::path("runs") / cfg.name : fs::path(output);
+    inv.opts.np = np > 0 ? np : static_cast<int>(cfg.doc.integer("resources.np"));
+    inv.opts.jobs = jobs > 0 ? jobs : static_cast<int>(cfg.doc.integer("resources.jobs"));
+    inv.opts.force = force;
+    inv.dry_run = dry_run;
+    inv.list_tasks = list_tasks;
+    if (task >= 0) inv.task = task;
+    return run_pipeline(cfg, inv, out);
+  } catch (const config::ConfigError& e) {
+    err << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const NotImplemented& e) {
+    err << "error: " << e.what() << "\n";
+    return kExitNotImplemented;
+  } catch (const MissingInput& e) {
+    err << "error: " << e.what() << "\n";
+    return kExitFailed;
+  } catch (const engine::Interrupted& e) {
+    err << "orchestrate: " << e.what() << "; finished jobs are kept, rerun the same command to resume\n";
+    return 128 + e.signal;
+  } catch (const std::exception& e) {
+    err << "error: " << e.what() << "\n";
+    return kExitFailed;
+  }
+}
+
+}  // namespace mill

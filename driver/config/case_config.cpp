@@ -1,0 +1,359 @@
+// Case-file and ore-card validation: unknown keys, types, ranges, files.
+#include "config/case_config.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace mill::config {
+namespace fs = std::filesystem;
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j)
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+namespace {
+
+std::string scalar_text(const YAML::Node& n) {
+  if (n.IsScalar()) return "'" + n.Scalar() + "'";
+  if (n.IsSequence()) return "a list";
+  if (n.IsMap()) return "a section";
+  return "nothing";
+}
+
+int line_of(const YAML::Node& n) { return n.Mark().line >= 0 ? n.Mark().line + 1 : 0; }
+
+// Best "did you mean" among declared keys and sections, or "".
+std::string suggest(const Schema& s, const std::string& path) {
+  std::vector<std::string> candidates;
+  for (const auto& k : s.keys) {
+    candidates.push_back(k.path);
+    std::string p = k.path;
+    for (size_t dot = p.rfind('.'); dot != std::string::npos; dot = p.rfind('.')) {
+      p = p.substr(0, dot);
+      candidates.push_back(p);
+    }
+  }
+  std::string best;
+  size_t best_d = std::string::npos;
+  const std::string leaf = path.substr(path.rfind('.') == std::string::npos ? 0 : path.rfind('.') + 1);
+  for (const auto& c : candidates) {
+    size_t d = edit_distance(path, c);
+    // Also accept a right leaf under a wrong-looking parent (e.g. "rotor.rmp").
+    const std::string cleaf = c.substr(c.rfind('.') == std::string::npos ? 0 : c.rfind('.') + 1);
+    d = std::min(d, edit_distance(leaf, cleaf) + (c == path ? 0 : 1));
+    if (d < best_d) {
+      best_d = d;
+      best = c;
+    }
+  }
+  const size_t limit = std::max<size_t>(2, path.size() / 3);
+  return best_d <= limit ? best : "";
+}
+
+class Validator {
+ public:
+  Validator(const Schema& s, std::string file) : s_(s), file_(std::move(file)) {}
+
+  [[noreturn]] void fail(int line, const std::string& key, const std::string& msg) const {
+    throw ConfigError(fmt::format("{}:{}: {}: {}", file_, line, key, msg));
+  }
+
+  // Walk a mapping node; `prefix` is the dotted path of the section.
+  void walk(const YAML::Node& map, const std::string& prefix, std::map<std::string, YAML::Node>& out,
+            std::map<std::string, int>& lines) {
+    for (auto it = map.begin(); it != map.end(); ++it) {
+      const std::string name = it->first.as<std::string>();
+      const std::string path = prefix.empty() ? name : prefix + "." + name;
+      const int line = line_of(it->first);
+      const KeyDef* k = s_.find(path);
+      if (k) {
+        check_value(*k, it->second, line);
+        if (out.count(path)) fail(line, path, "given twice");
+        out[path] = it->second;
+        lines[path] = line;
+      } else if (s_.is_section(path)) {
+        if (!it->second.IsMap())
+          fail(line, path, fmt::format("expected a section of keys, got {}", scalar_text(it->second)));
+        walk(it->second, path, out, lines);
+      } else {
+        std::string hint = suggest(s_, path);
+        fail(line, path,
+             fmt::format("unknown key in {}{}", s_.what,
+                         hint.empty() ? " (see docs/config.md)" : "; did you mean '" + hint + "'?"));
+      }
+    }
+  }
+
+  void check_number(const KeyDef& k, const YAML::Node& n, int line, const std::string& label, bool integer) {
+    if (!n.IsScalar()) fail(line, label, fmt::format("expected {}, got {}", expected_text(k), scalar_text(n)));
+    double v = 0;
+    try {
+      if (integer) {
+        long i = n.as<long>();
+        v = static_cast<double>(i);
+      } else {
+        v = n.as<double>();
+      }
+    } catch (const YAML::Exception&) {
+      fail(line, label, fmt::format("expected {}, got {}", expected_text(k), scalar_text(n)));
+    }
+    if (!std::isfinite(v)) fail(line, label, fmt::format("expected a finite {}, got {}", expected_text(k), scalar_text(n)));
+    bool bad = false;
+    if (k.min) bad |= k.min_exclusive ? !(v > *k.min) : !(v >= *k.min);
+    if (k.max) bad |= k.max_exclusive ? !(v < *k.max) : !(v <= *k.max);
+    if (bad) fail(line, label, fmt::format("expected {}, got {}", expected_text(k), n.Scalar()));
+  }
+
+  void check_value(const KeyDef& k, const YAML::Node& n, int line) {
+    switch (k.type) {
+      case KeyType::Int: check_number(k, n, line, k.path, true); break;
+      case KeyType::Real: check_number(k, n, line, k.path, false); break;
+      case KeyType::Bool:
+        try {
+          if (!n.IsScalar()) throw YAML::Exception(YAML::Mark(), "");
+          (void)n.as<bool>();
+        } catch (const YAML::Exception&) {
+          fail(line, k.path, fmt::format("expected true or false, got {}", scalar_text(n)));
+        }
+        break;
+      case KeyType::String:
+      case KeyType::Path:
+        if (!n.IsScalar() || n.Scalar().empty())
+          fail(line, k.path, fmt::format("expected {}, got {}", type_name(k.type), scalar_text(n)));
+        break;
+      case KeyType::Choice:
+        if (!n.IsScalar() || std::find(k.choices.begin(), k.choices.end(), n.Scalar()) == k.choices.end())
+          fail(line, k.path, fmt::format("expected {}, got {}", expected_text(k), scalar_text(n)));
+        break;
+      case KeyType::RealList:
+      case KeyType::IntList: {
+        const bool integer = k.type == KeyType::IntList;
+        if (n.IsScalar()) {
+          check_number(k, n, line, k.path, integer);
+        } else if (n.IsSequence()) {
+          if (n.size() == 0) fail(line, k.path, fmt::format("expected a non-empty {}, got []", type_name(k.type)));
+          for (size_t i = 0; i < n.size(); ++i)
+            check_number(k, n[i], line_of(n[i]) ? line_of(n[i]) : line, fmt::format("{}[{}]", k.path, i), integer);
+        } else {
+          fail(line, k.path, fmt::format("expected {}, got {}", type_name(k.type), scalar_text(n)));
+        }
+        break;
+      }
+    }
+  }
+
+ private:
+  const Schema& s_;
+  std::string file_;
+};
+
+}  // namespace
+
+Document Document::parse(const std::string& text, const std::string& file_label, const Schema& schema) {
+  Document d;
+  d.file_ = file_label;
+  d.schema_ = &schema;
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(fmt::format("{}:{}: not valid YAML: {}", file_label, e.mark.line + 1, e.msg));
+  }
+  if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
+  if (!root.IsMap()) throw ConfigError(fmt::format("{}:1: expected a YAML mapping of keys at the top level", file_label));
+  Validator v(schema, file_label);
+  v.walk(root, "", d.values_, d.lines_);
+  for (const auto& k : schema.keys) {
+    if (d.values_.count(k.path)) continue;
+    if (!k.default_yaml.empty()) {
+      d.values_[k.path] = YAML::Load(k.default_yaml);
+      d.lines_[k.path] = 0;
+    } else if (!k.optional) {
+      throw ConfigError(fmt::format("{}: {}: required key is missing; expected {} ({})", file_label, k.path,
+                                    expected_text(k), k.doc));
+    }
+  }
+  return d;
+}
+
+Document Document::load(const fs::path& file, const Schema& schema) {
+  std::ifstream in(file);
+  if (!in) throw ConfigError(fmt::format("{}: cannot open {} (no such file or not readable)", file.string(), schema.what));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse(ss.str(), file.string(), schema);
+}
+
+const KeyDef& Document::def(const std::string& path) const {
+  const KeyDef* k = schema_ ? schema_->find(path) : nullptr;
+  if (!k) throw std::logic_error("undeclared config key requested: " + path);
+  return *k;
+}
+
+bool Document::has(const std::string& path) const {
+  def(path);
+  return values_.count(path) > 0;
+}
+
+namespace {
+const YAML::Node& need(const std::map<std::string, YAML::Node>& m, const std::string& path) {
+  auto it = m.find(path);
+  if (it == m.end()) throw std::logic_error("optional config key read without has(): " + path);
+  return it->second;
+}
+}  // namespace
+
+double Document::real(const std::string& path) const {
+  def(path);
+  return need(values_, path).as<double>();
+}
+long Document::integer(const std::string& path) const {
+  def(path);
+  return need(values_, path).as<long>();
+}
+bool Document::boolean(const std::string& path) const {
+  def(path);
+  return need(values_, path).as<bool>();
+}
+std::string Document::str(const std::string& path) const {
+  def(path);
+  return need(values_, path).as<std::string>();
+}
+std::vector<double> Document::reals(const std::string& path) const {
+  def(path);
+  const YAML::Node& n = need(values_, path);
+  if (n.IsScalar()) return {n.as<double>()};
+  std::vector<double> v;
+  for (const auto& x : n) v.push_back(x.as<double>());
+  return v;
+}
+int Document::line(const std::string& path) const {
+  auto it = lines_.find(path);
+  return it == lines_.end() ? 0 : it->second;
+}
+std::string Document::where(const std::string& path) const {
+  const int l = line(path);
+  return l > 0 ? fmt::format("{}:{}: {}", file_, l, path) : fmt::format("{}: {} (default)", file_, path);
+}
+
+nlohmann::json Document::to_json() const {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [path, node] : values_) {
+    const KeyDef& k = def(path);
+    switch (k.type) {
+      case KeyType::Int: j[path] = node.as<long>(); break;
+      case KeyType::Real: j[path] = node.as<double>(); break;
+      case KeyType::Bool: j[path] = node.as<bool>(); break;
+      case KeyType::RealList:
+      case KeyType::IntList: j[path] = reals(path); break;
+      default: j[path] = node.as<std::string>(); break;
+    }
+  }
+  return j;
+}
+
+void check_ore(const Document& ore) {
+  if (ore.real("ucs") <= ore.real("tensile_strength"))
+    throw ConfigError(fmt::format("{}: expected ucs > tensile_strength (rocks: ucs/tensile ~ 5-20), got ucs {:g} Pa <= {:g} Pa",
+                                  ore.where("ucs"), ore.real("ucs"), ore.real("tensile_strength")));
+  if (ore.real("youngs_modulus") < 1e6)
+    throw ConfigError(fmt::format("{}: expected Young's modulus in Pa (rock: 1e9-1e11), got {:g}; did you give GPa?",
+                                  ore.where("youngs_modulus"), ore.real("youngs_modulus")));
+}
+
+namespace {
+
+// Cross-key checks of a case: the geometry must fit, lists must be ordered.
+void check_case(const Document& d) {
+  auto fail = [&](const std::string& key, const std::string& msg) {
+    throw ConfigError(fmt::format("{}: {}", d.where(key), msg));
+  };
+  const double D = d.real("mill.flywheel.diameter"), W = d.real("mill.housing.width");
+  const double H = d.real("mill.housing.height");
+  if (d.real("mill.flywheel.hub_diameter") >= D)
+    fail("mill.flywheel.hub_diameter", fmt::format("expected less than mill.flywheel.diameter ({:g} m), got {:g} m", D,
+                                                   d.real("mill.flywheel.hub_diameter")));
+  if (std::abs(d.real("mill.flywheel.axis_x")) + D / 2 >= W / 2)
+    fail("mill.flywheel.diameter", fmt::format("flywheel ({:g} m at x = {:g} m) does not fit in the housing width {:g} m", D,
+                                               d.real("mill.flywheel.axis_x"), W));
+  const double ah = d.real("mill.flywheel.axis_height");
+  if (ah - D / 2 <= 0 || ah + D / 2 >= H)
+    fail("mill.flywheel.axis_height",
+         fmt::format("flywheel (diameter {:g} m) must fit between floor and roof (height {:g} m), got axis at {:g} m", D, H, ah));
+  if (d.real("mill.flywheel.plate_width") >= d.real("mill.housing.depth"))
+    fail("mill.flywheel.plate_width", fmt::format("expected less than mill.housing.depth ({:g} m), got {:g} m",
+                                                  d.real("mill.housing.depth"), d.real("mill.flywheel.plate_width")));
+  for (const char* side : {"inlet", "outlet"}) {
+    const std::string c = fmt::format("mill.{}.center_x", side), s = fmt::format("mill.{}.size", side);
+    if (std::abs(d.real(c)) + d.real(s) / 2 > W / 2 || d.real(s) > d.real("mill.housing.depth"))
+      fail(s, fmt::format("the {} ({:g} m at x = {:g} m) must lie on the housing ({:g} m wide, {:g} m deep)", side, d.real(s),
+                          d.real(c), W, d.real("mill.housing.depth")));
+  }
+  const auto edges = d.reals("breakage.size_fraction_edges");
+  if (edges.size() < 2) fail("breakage.size_fraction_edges", "expected at least two edges (one fraction)");
+  for (size_t i = 1; i < edges.size(); ++i)
+    if (edges[i] <= edges[i - 1])
+      fail("breakage.size_fraction_edges",
+           fmt::format("expected strictly ascending edges, got {:g} after {:g} (item {})", edges[i], edges[i - 1], i));
+  if (d.real("injection.lump_diameter") >= d.real("mill.inlet.size"))
+    fail("injection.lump_diameter", fmt::format("expected smaller than the inlet ({:g} m), got {:g} m",
+                                                d.real("mill.inlet.size"), d.real("injection.lump_diameter")));
+}
+
+// Ore card path: absolute; else relative to the case file; else to the project.
+fs::path resolve_ore(const Document& d, const fs::path& case_file, const fs::path& project_dir) {
+  const fs::path p = d.str("ore.card");
+  std::vector<fs::path> tried;
+  if (p.is_absolute()) {
+    tried.push_back(p);
+  } else {
+    tried.push_back(case_file.parent_path() / p);
+    tried.push_back(project_dir / p);
+    tried.push_back(project_dir / "liggghts_inputs" / "materials" / p);
+    tried.push_back(project_dir / "liggghts_inputs" / "materials" / (p.string() + ".yaml"));
+  }
+  for (const auto& t : tried)
+    if (fs::is_regular_file(t)) return fs::weakly_canonical(t);
+  std::string where;
+  for (const auto& t : tried) where += "\n  " + t.string();
+  std::string have;
+  const fs::path mats = project_dir / "liggghts_inputs" / "materials";
+  if (fs::is_directory(mats))
+    for (const auto& e : fs::directory_iterator(mats))
+      if (e.path().extension() == ".yaml") have += " " + e.path().stem().string();
+  throw ConfigError(fmt::format("{}: ore card '{}' not found; looked in:{}\nbundled ore cards:{}", d.where("ore.card"),
+                                p.string(), where, have.empty() ? " (none)" : have));
+}
+
+}  // namespace
+
+CaseConfig load_case(const fs::path& file, const fs::path& project_dir) {
+  if (!fs::exists(file)) throw ConfigError(fmt::format("{}: case file not found", file.string()));
+  CaseConfig c;
+  c.file = fs::weakly_canonical(file);
+  c.project_dir = project_dir;
+  c.doc = Document::load(file, case_schema());
+  check_case(c.doc);
+  c.name = c.doc.has("name") ? c.doc.str("name") : file.stem().string();
+  for (char ch : c.name)
+    if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.'))
+      throw ConfigError(fmt::format("{}: expected letters, digits, '-', '_' or '.', got '{}'", c.doc.where("name"), c.name));
+  c.ore_file = resolve_ore(c.doc, file, project_dir);
+  c.ore = Document::load(c.ore_file, ore_schema());
+  check_ore(c.ore);
+  return c;
+}
+
+}  // namespace mill::config

@@ -1,0 +1,71 @@
+// Loading and validating a case file and its ore card against the schema.
+// Every user-caused problem becomes a ConfigError whose text names the file,
+// line, key, the value found and what is expected; main() exits with 2.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "config/schema.h"
+
+namespace mill::config {
+
+struct ConfigError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// A YAML file validated against a schema, with defaults filled in.
+class Document {
+ public:
+  static Document load(const std::filesystem::path& file, const Schema& schema);
+  static Document parse(const std::string& text, const std::string& file_label, const Schema& schema);
+
+  bool has(const std::string& path) const;
+  double real(const std::string& path) const;
+  long integer(const std::string& path) const;
+  bool boolean(const std::string& path) const;
+  std::string str(const std::string& path) const;
+  std::vector<double> reals(const std::string& path) const;
+  // 1-based line of the key in the file; 0 when it took its default.
+  int line(const std::string& path) const;
+  // Canonical JSON (sorted keys, defaults included): the basis of job hashes.
+  nlohmann::json to_json() const;
+  // "file:line: key" prefix for messages about a key.
+  std::string where(const std::string& path) const;
+
+  const std::string& file() const { return file_; }
+
+ private:
+  const KeyDef& def(const std::string& path) const;
+  std::string file_;
+  const Schema* schema_ = nullptr;
+  std::map<std::string, YAML::Node> values_;
+  std::map<std::string, int> lines_;
+};
+
+// A case ready to run: the case document, its ore card, and where things live.
+struct CaseConfig {
+  std::filesystem::path file;         // the case file (absolute)
+  std::string name;                   // case name (for runs/<name>)
+  Document doc;                       // validated case
+  std::filesystem::path ore_file;     // resolved ore card (absolute)
+  Document ore;                       // validated ore card
+  std::filesystem::path project_dir;  // templates, foam_case, ... live here
+};
+
+// Load a case: schema validation, cross-key checks, ore card resolution.
+CaseConfig load_case(const std::filesystem::path& file, const std::filesystem::path& project_dir);
+
+// Physical consistency of an ore card (UCS > tensile strength, ...).
+void check_ore(const Document& ore);
+
+// Levenshtein distance, for "did you mean".
+size_t edit_distance(const std::string& a, const std::string& b);
+
+}  // namespace mill::config

@@ -1,0 +1,251 @@
+// The case-file and ore-card schemas: the single place a key is declared.
+#include "config/schema.h"
+
+#include <fmt/format.h>
+
+#include <sstream>
+
+namespace mill::config {
+namespace {
+
+// Builders keep the table below readable: one line per key.
+KeyDef key(std::string path, KeyType t, std::string unit, std::string def, std::string doc) {
+  KeyDef k;
+  k.path = std::move(path);
+  k.type = t;
+  k.unit = std::move(unit);
+  k.default_yaml = std::move(def);
+  k.doc = std::move(doc);
+  return k;
+}
+KeyDef positive(KeyDef k) {
+  k.min = 0.0;
+  k.min_exclusive = true;
+  return k;
+}
+KeyDef at_least(KeyDef k, double lo) {
+  k.min = lo;
+  return k;
+}
+KeyDef range(KeyDef k, double lo, bool lo_ex, double hi, bool hi_ex) {
+  k.min = lo;
+  k.min_exclusive = lo_ex;
+  k.max = hi;
+  k.max_exclusive = hi_ex;
+  return k;
+}
+KeyDef choice(std::string path, std::string def, std::vector<std::string> choices,
+              std::string doc) {
+  KeyDef k = key(std::move(path), KeyType::Choice, "", std::move(def), std::move(doc));
+  k.choices = std::move(choices);
+  return k;
+}
+KeyDef opt(KeyDef k) {
+  k.optional = true;
+  return k;
+}
+
+using T = KeyType;
+
+Schema make_case_schema() {
+  Schema s;
+  s.what = "case file";
+  s.keys = {
+      opt(key("name", T::String, "", "", "Case name; default: the case file's name without .yaml")),
+      opt(key("description", T::String, "", "", "Free text shown in the report")),
+
+      // --- mill geometry (shared by OpenFOAM and LIGGGHTS through STL) ---
+      positive(key("mill.housing.height", T::Real, "m", "4.0", "Housing height (y, vertical)")),
+      positive(key("mill.housing.width", T::Real, "m", "1.6", "Housing width (x)")),
+      positive(key("mill.housing.depth", T::Real, "m", "0.5", "Housing depth (z, along the rotor axis)")),
+      positive(key("mill.flywheel.diameter", T::Real, "m", "1.0", "Flywheel tip diameter (beater plate tips)")),
+      positive(key("mill.flywheel.hub_diameter", T::Real, "m", "0.3", "Hub (disc) diameter carrying the plates")),
+      at_least(key("mill.flywheel.n_plates", T::Int, "", "6", "Number of flat beater plates"), 1),
+      positive(key("mill.flywheel.plate_width", T::Real, "m", "0.3", "Beater plate width along the axis")),
+      positive(key("mill.flywheel.plate_thickness", T::Real, "m", "0.02", "Beater plate thickness")),
+      positive(key("mill.flywheel.axis_height", T::Real, "m", "1.2", "Height of the rotor axis above the housing floor")),
+      key("mill.flywheel.axis_x", T::Real, "m", "0.0", "Horizontal offset of the rotor axis from the housing centre"),
+      key("mill.inlet.center_x", T::Real, "m", "0.0", "Inlet centre (x) on the housing roof"),
+      positive(key("mill.inlet.size", T::Real, "m", "0.3", "Inlet opening: side of a square on the roof")),
+      key("mill.outlet.center_x", T::Real, "m", "0.0", "Outlet centre (x) on the housing floor"),
+      positive(key("mill.outlet.size", T::Real, "m", "0.4", "Outlet opening: side of a square on the floor")),
+
+      // --- rotor ---
+      positive(key("rotor.rpm", T::RealList, "rpm", "[2000]", "Rotor speeds; one flow/transport run per speed")),
+
+      // --- gas ---
+      choice("gas.model", "incompressible", {"incompressible", "compressible"},
+             "simpleFoam (incompressible) or rhoSimpleFoam (air as a perfect gas)"),
+      positive(key("gas.density", T::Real, "kg/m^3", "1.2", "Gas density (incompressible model; reference for drag)")),
+      positive(key("gas.viscosity", T::Real, "Pa s", "1.8e-5", "Gas dynamic viscosity")),
+      positive(key("gas.temperature", T::Real, "K", "293.15", "Gas temperature (compressible model)")),
+      positive(key("gas.pressure", T::Real, "Pa", "101325", "Absolute ambient pressure (compressible model)")),
+      key("gas.outlet_pressure_drop", T::Real, "Pa", "0", "Outlet static pressure below inlet total pressure"),
+
+      // --- CFD numerics ---
+      choice("flow.mesh_preset", "quick", {"tiny", "quick", "reference"},
+             "tiny: a few thousand cells (tests); quick: tens of thousands; reference: ~600k with layers"),
+      at_least(key("flow.max_iterations", T::Int, "", "600", "Iteration cap of the steady solver"), 1),
+      positive(key("flow.residual_target", T::Real, "", "1e-4", "Initial-residual target for p and U (convergence)")),
+
+      // --- sampling of the flow field ---
+      positive(key("sample.spacing", T::Real, "m", "0.05", "Spacing of the uniform 3D sampling grid")),
+      key("sample.turbulence", T::Bool, "", "false", "Also sample k and omega"),
+
+      // --- ore injection (stage 1 transport) ---
+      at_least(key("injection.n_lumps", T::Int, "", "360", "Number of ore lumps injected"), 1),
+      positive(key("injection.lump_diameter", T::Real, "m", "0.04", "Lump diameter")),
+      positive(key("injection.duration", T::Real, "s", "0.2", "Lumps are inserted evenly over this time")),
+      positive(key("injection.time_limit", T::Real, "s", "2.0", "Transport run stops at this time")),
+      positive(key("injection.timestep", T::Real, "s", "5e-6", "Particle time step")),
+      at_least(key("injection.seed", T::Int, "", "4711", "Random seed of the insertion"), 1),
+
+      // --- ore ---
+      key("ore.card", T::Path, "", "liggghts_inputs/materials/sandstone.yaml",
+          "Ore card (YAML); relative to the case file, else to the project"),
+
+      // --- bonded lump model (stage 2) ---
+      at_least(key("lump.n_elements", T::Int, "", "3344", "Elements (spheres) per lump"), 2),
+      positive(key("lump.diameter", T::Real, "m", "0.04", "Lump diameter")),
+      range(key("lump.radius_spread", T::Real, "", "0.25", "Element radii uniform in (1 +- spread) x mean"), 0, false, 1, true),
+      at_least(key("lump.n_packings", T::Int, "", "1", "Distinct random packings (lumps) for statistics"), 1),
+      at_least(key("lump.seed", T::Int, "", "1001", "Seed of the first packing"), 1),
+      at_least(key("lump.bond_gap", T::Real, "", "0.1", "Bond pairs whose gap is below this x mean radius"), 0),
+      at_least(key("lump.max_bonds", T::Int, "", "16", "Cap of bonds per element"), 1),
+      positive(key("lump.bond_radius_multiplier", T::Real, "", "1.0", "Bond disc radius = multiplier x min(Ri, Rj)")),
+
+      // --- breakage sweep (stage 2) ---
+      choice("breakage.conditions", "sweep", {"sweep", "transport"},
+             "sweep: the velocities/angles below; transport: binned from stage 1 impacts"),
+      positive(key("breakage.velocities", T::RealList, "m/s", "[4, 10, 20, 40, 60, 80, 100, 120, 150, 169]",
+                   "Impact speeds of the sweep")),
+      range(key("breakage.angles", T::RealList, "deg", "[90]", "Impact angles to the surface (90 = normal)"), 0, true, 90, false),
+      at_least(key("breakage.repeats", T::Int, "", "1", "Repeats per condition (random orientation)"), 1),
+      positive(key("breakage.duration_after_contact", T::Real, "s", "6e-3", "Simulated time after first contact")),
+      at_least(key("breakage.timestep", T::Real, "s", "0", "Time step; 0 = automatic from the stability limit"), 0),
+      at_least(key("breakage.dump_interval", T::Real, "s", "5e-4", "VTK dump interval; 0 = no dumps"), 0),
+      range(key("breakage.size_fraction_edges", T::RealList, "", "[0, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.85, 1.0]",
+                "Edges of the size fractions, piece diameter / lump diameter (ascending)"), 0, false, 1, false),
+      range(key("breakage.critical_largest_fraction", T::Real, "", "0.05",
+                "Critical velocity: largest piece mass fraction falls below this"), 0, true, 1, true),
+      at_least(key("breakage.velocity_bins", T::Int, "", "5", "transport conditions: bins of impact normal speed"), 1),
+      key("breakage.include_wall_impacts", T::Bool, "", "false", "transport conditions: also wall impacts"),
+
+      // --- calibration (virtual lab tests) ---
+      at_least(key("calibrate.n_elements", T::Int, "", "1500", "Elements in a lab specimen"), 20),
+      positive(key("calibrate.strain_rate", T::Real, "1/s", "0.5", "Platen strain rate of the UCS and Brazilian tests")),
+      at_least(key("calibrate.max_iterations", T::Int, "", "8", "Calibration iterations cap"), 1),
+      positive(key("calibrate.tolerance", T::Real, "", "0.1", "Relative tolerance on E, UCS and tensile strength")),
+      at_least(key("calibrate.seed", T::Int, "", "2002", "Seed of the specimen packing"), 1),
+
+      // --- resources ---
+      at_least(key("resources.np", T::Int, "", "1", "MPI ranks per engine run (--np overrides)"), 1),
+      at_least(key("resources.jobs", T::Int, "", "1", "Engine runs at once on this machine (--jobs overrides)"), 1),
+  };
+  return s;
+}
+
+Schema make_ore_schema() {
+  Schema s;
+  s.what = "ore card";
+  s.keys = {
+      key("name", T::String, "", "", "Ore name"),
+      opt(key("source", T::String, "", "", "Where the values come from (citation)")),
+      positive(key("density", T::Real, "kg/m^3", "", "Bulk density")),
+      positive(key("youngs_modulus", T::Real, "Pa", "", "Young's modulus E")),
+      range(key("poisson_ratio", T::Real, "", "", "Poisson's ratio nu"), 0, false, 0.5, true),
+      positive(key("ucs", T::Real, "Pa", "", "Uniaxial compressive strength")),
+      positive(key("tensile_strength", T::Real, "Pa", "", "Tensile strength (Brazilian)")),
+      at_least(key("friction", T::Real, "", "0.5", "Coulomb friction coefficient (element-element and walls)"), 0),
+      range(key("restitution", T::Real, "", "0.5", "Coefficient of restitution"), 0, true, 1, false),
+      // Calibrated micro parameters: written by `--stage calibrate`, optional.
+      opt(positive(key("calibrated.bond_modulus", T::Real, "Pa", "", "Bond modulus E_b (k_n = E_b / L)"))),
+      opt(positive(key("calibrated.stiffness_ratio", T::Real, "", "", "Bond normal/shear stiffness ratio"))),
+      opt(positive(key("calibrated.bond_tensile_strength", T::Real, "Pa", "", "Bond tensile strength"))),
+      opt(positive(key("calibrated.bond_cohesion", T::Real, "Pa", "", "Bond shear cohesion"))),
+      opt(range(key("calibrated.bond_friction_angle", T::Real, "deg", "", "Bond Mohr-Coulomb friction angle"), 0, false, 90, true)),
+      opt(key("calibrated.input_hash", T::String, "", "", "Hash of the macro properties these were fitted to")),
+  };
+  return s;
+}
+
+}  // namespace
+
+const KeyDef* Schema::find(const std::string& path) const {
+  for (const auto& k : keys)
+    if (k.path == path) return &k;
+  return nullptr;
+}
+
+bool Schema::is_section(const std::string& path) const {
+  const std::string prefix = path + ".";
+  for (const auto& k : keys)
+    if (k.path.compare(0, prefix.size(), prefix) == 0) return true;
+  return false;
+}
+
+const Schema& case_schema() {
+  static const Schema s = make_case_schema();
+  return s;
+}
+
+const Schema& ore_schema() {
+  static const Schema s = make_ore_schema();
+  return s;
+}
+
+std::string type_name(KeyType t) {
+  switch (t) {
+    case KeyType::Int: return "integer";
+    case KeyType::Real: return "number";
+    case KeyType::Bool: return "true/false";
+    case KeyType::String: return "text";
+    case KeyType::Choice: return "choice";
+    case KeyType::Path: return "file path";
+    case KeyType::RealList: return "list of numbers";
+    case KeyType::IntList: return "list of integers";
+  }
+  return "?";
+}
+
+std::string expected_text(const KeyDef& k) {
+  if (k.type == KeyType::Choice) {
+    std::string s = "one of ";
+    for (size_t i = 0; i < k.choices.size(); ++i) s += (i ? ", " : "") + k.choices[i];
+    return s;
+  }
+  std::string unit = k.unit.empty() ? "" : " " + k.unit;
+  if (k.min && k.max)
+    return fmt::format("{} in {}{:g}, {:g}{}{}", type_name(k.type), k.min_exclusive ? "(" : "[", *k.min,
+                       *k.max, k.max_exclusive ? ")" : "]", unit);
+  if (k.min) return fmt::format("{} {} {:g}{}", type_name(k.type), k.min_exclusive ? ">" : ">=", *k.min, unit);
+  if (k.max) return fmt::format("{} {} {:g}{}", type_name(k.type), k.max_exclusive ? "<" : "<=", *k.max, unit);
+  return type_name(k.type) + (unit.empty() ? "" : " (" + k.unit + ")");
+}
+
+namespace {
+void table(std::ostringstream& o, const Schema& s) {
+  o << "| key | type | unit | default | allowed | description |\n";
+  o << "|---|---|---|---|---|---|\n";
+  for (const auto& k : s.keys) {
+    std::string def = k.default_yaml.empty() ? (k.optional ? "(optional)" : "(required)") : "`" + k.default_yaml + "`";
+    o << "| `" << k.path << "` | " << type_name(k.type) << " | " << (k.unit.empty() ? "-" : k.unit) << " | "
+      << def << " | " << expected_text(k) << " | " << k.doc << " |\n";
+  }
+}
+}  // namespace
+
+std::string schema_markdown() {
+  std::ostringstream o;
+  o << "# Configuration reference\n\n"
+    << "Generated by `orchestrate --print-schema`; do not edit by hand.\n"
+    << "All quantities are SI unless the unit column says otherwise. A key that is absent\n"
+    << "takes its default; an unknown key is an error.\n\n"
+    << "## Case file (`cases/*.yaml`)\n\n";
+  table(o, case_schema());
+  o << "\n## Ore card (`liggghts_inputs/materials/*.yaml`)\n\n";
+  table(o, ore_schema());
+  return o.str();
+}
+
+}  // namespace mill::config

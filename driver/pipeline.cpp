@@ -1,0 +1,216 @@
+// Stage execution: plan, decide per job, run with a small pool, finalize.
+#include "pipeline.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <thread>
+
+#include "engine/runner.h"
+#include "jobs/job_store.h"
+#include "progress.h"
+
+namespace mill {
+namespace fs = std::filesystem;
+
+std::vector<std::string> resolve_stages(const std::string& stage) {
+  const auto& names = stage_names();
+  if (stage == "all") return names;
+  if (std::find(names.begin(), names.end(), stage) != names.end()) return {stage};
+  std::string list;
+  for (const auto& n : names) list += n + ", ";
+  std::string hint;
+  size_t best = 99;
+  for (const auto& n : names)
+    if (config::edit_distance(stage, n) < best) best = config::edit_distance(stage, n), hint = n;
+  throw config::ConfigError(fmt::format("--stage: expected one of {}all, got '{}'{}", list, stage,
+                                        best <= 2 ? "; did you mean '" + hint + "'?" : ""));
+}
+
+namespace {
+
+struct JobRow {
+  JobSpec spec;
+  jobs::Verdict verdict;
+};
+
+std::vector<JobRow> decide_all(const jobs::JobStore& store, const Plan& plan, bool force) {
+  std::vector<JobRow> rows;
+  for (const auto& j : plan.jobs) rows.push_back({j, store.decide(j.label, j.inputs, force)});
+  return rows;
+}
+
+std::string verdict_tag(const jobs::Verdict& v) {
+  if (v.decision == jobs::Decision::Skip) return "done";
+  if (v.decision == jobs::Decision::Busy) return "busy";
+  return "todo";
+}
+
+// Keep a copy of what was run next to the results (provenance).
+void write_provenance(const config::CaseConfig& cfg, const fs::path& run_dir) {
+  fs::create_directories(run_dir);
+  auto copy = [&](const fs::path& from, const fs::path& to) {
+    std::ifstream in(from);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    jobs::atomic_write(to, text);
+  };
+  copy(cfg.file, run_dir / "case.yaml");
+  copy(cfg.ore_file, run_dir / "ore.yaml");
+  nlohmann::json j = {{"case_file", cfg.file.string()},   {"ore_card", cfg.ore_file.string()},
+                      {"case", cfg.doc.to_json()},         {"ore", cfg.ore.to_json()},
+                      {"orchestrate_version", MILL_VERSION}};
+  jobs::atomic_write(run_dir / "resolved_case.json", j.dump(2) + "\n");
+}
+
+// Run one job with its STATUS bookkeeping. Returns "" on success, else the reason.
+std::string run_one(Stage& stage, StageContext& ctx, const jobs::JobStore& store, const JobSpec& job) {
+  store.mark_running(job.label, job.inputs);
+  const auto t0 = std::chrono::steady_clock::now();
+  ctx.progress.job_begin(job.label);
+  std::string reason;
+  try {
+    stage.run_job(ctx, job, store.job_dir(job.label));
+  } catch (const engine::Interrupted& e) {
+    store.mark_failed(job.label, e.what());
+    ctx.progress.job_end(job.label, false, 0);
+    throw;
+  } catch (const NotImplemented&) {
+    store.mark_failed(job.label, "not implemented");
+    throw;
+  } catch (const std::exception& e) {
+    reason = e.what();
+  }
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (reason.empty()) {
+    store.mark_done(job.label);
+  } else {
+    store.mark_failed(job.label, reason.substr(0, reason.find('\n')));
+  }
+  ctx.progress.job_end(job.label, reason.empty(), secs);
+  return reason;
+}
+
+}  // namespace
+
+int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostream& out) {
+  auto stages = make_stages();
+  engine::Runner runner;
+  Progress progress(out, isatty(STDOUT_FILENO) && &out == &std::cout);
+  const fs::path run_dir = inv.opts.output;
+
+  if (inv.task && inv.stages.size() != 1)
+    throw config::ConfigError("--task: needs exactly one --stage (the stage whose job list --list-tasks shows), not 'all'");
+  bool provenance_written = false;
+
+  if (inv.dry_run)
+    out << fmt::format("plan for case '{}' ({}), output {}\n", cfg.name, cfg.file.string(), run_dir.string());
+
+  for (const auto& name : inv.stages) {
+    auto it = std::find_if(stages.begin(), stages.end(), [&](const auto& s) { return s->name() == name; });
+    Stage& stage = **it;
+    StageContext ctx{cfg, inv.opts, run_dir, run_dir / name, runner, progress};
+    const jobs::JobStore store(ctx.stage_dir);
+    const Plan plan = stage.plan(ctx);
+    const auto rows = decide_all(store, plan, inv.opts.force);
+    const int n_done = static_cast<int>(std::count_if(rows.begin(), rows.end(), [](const JobRow& r) {
+      return r.verdict.decision == jobs::Decision::Skip;
+    }));
+
+    if (inv.list_tasks) {
+      for (size_t i = 0; i < rows.size(); ++i)
+        out << fmt::format("{}\t{}\t{}\t{}\n", i, rows[i].spec.label, verdict_tag(rows[i].verdict), rows[i].spec.summary);
+      if (rows.empty() && !plan.note.empty()) out << "# " << name << ": no tasks yet: " << plan.note << "\n";
+      continue;
+    }
+    if (inv.dry_run) {
+      out << fmt::format("stage {} - {}{}\n  {} job{}, {} done, {} to run\n", name, stage.description(),
+                         stage.implemented() ? "" : " [not implemented yet]", rows.size(), rows.size() == 1 ? "" : "s",
+                         n_done, rows.size() - n_done);
+      if (!plan.note.empty()) out << "  note: " << plan.note << "\n";
+      for (size_t i = 0; i < rows.size(); ++i)
+        out << fmt::format("  [{}] {:>3} {:<22} {} ({}, id {})\n", verdict_tag(rows[i].verdict), i, rows[i].spec.label,
+                           rows[i].spec.summary, rows[i].verdict.why, jobs::job_id(rows[i].spec.inputs));
+      continue;
+    }
+
+    std::vector<JobRow> todo;
+    if (inv.task) {
+      if (*inv.task < 0 || *inv.task >= static_cast<int>(rows.size()))
+        throw config::ConfigError(fmt::format("--task: expected an index in [0, {}] for stage '{}', got {}",
+                                              static_cast<int>(rows.size()) - 1, name, *inv.task));
+      todo.push_back(rows[*inv.task]);
+    } else {
+      todo = rows;
+    }
+    if (!stage.implemented()) {
+      out << fmt::format("stage '{}' ({}) is not implemented yet: nothing was run and no output was written.\n", name,
+                         stage.description());
+      return kExitNotImplemented;
+    }
+
+    if (!provenance_written) write_provenance(cfg, run_dir), provenance_written = true;
+    progress.stage_begin(name, static_cast<int>(todo.size()),
+                         static_cast<int>(std::count_if(todo.begin(), todo.end(), [](const JobRow& r) {
+                           return r.verdict.decision == jobs::Decision::Skip;
+                         })));
+    std::vector<std::string> failures, busy;
+    std::mutex mu;
+    std::atomic<size_t> next{0};
+    std::exception_ptr fatal;
+    auto worker = [&]() {
+      for (;;) {
+        const size_t i = next.fetch_add(1);
+        if (i >= todo.size()) return;
+        const JobRow& r = todo[i];
+        if (r.verdict.decision == jobs::Decision::Skip) continue;
+        if (r.verdict.decision == jobs::Decision::Busy) {
+          std::lock_guard<std::mutex> g(mu);
+          busy.push_back(r.spec.label + ": " + r.verdict.why);
+          continue;
+        }
+        {
+          std::lock_guard<std::mutex> g(mu);
+          if (fatal) return;
+        }
+        if (r.verdict.why != "new") progress.info(fmt::format("[{}] rerun {}: {}", name, r.spec.label, r.verdict.why));
+        try {
+          const std::string reason = run_one(stage, ctx, store, r.spec);
+          if (!reason.empty()) {
+            std::lock_guard<std::mutex> g(mu);
+            failures.push_back(fmt::format("{}/{}: {}", name, r.spec.label, reason));
+          }
+        } catch (...) {
+          std::lock_guard<std::mutex> g(mu);
+          if (!fatal) fatal = std::current_exception();
+          return;
+        }
+      }
+    };
+    const int n_threads = std::max(1, std::min<int>(inv.opts.jobs, static_cast<int>(todo.size())));
+    std::vector<std::thread> pool;
+    for (int t = 0; t < n_threads; ++t) pool.emplace_back(worker);
+    for (auto& t : pool) t.join();
+    progress.stage_end();
+    if (fatal) std::rethrow_exception(fatal);
+
+    for (const auto& f : failures) out << "error: " << f << "\n";
+    for (const auto& b : busy) out << "warning: not run, " << b << "\n";
+    if (!failures.empty()) {
+      out << fmt::format("stage '{}': {} job(s) failed; fix the cause and rerun the same command: done jobs are kept.\n",
+                         name, failures.size());
+      return kExitFailed;
+    }
+    if (!busy.empty()) return kExitFailed;
+    // A single array task does not merge; the follow-up (whole stage) run does.
+    if (!inv.task) stage.finalize(ctx, plan.jobs);
+  }
+  return kExitOk;
+}
+
+}  // namespace mill

@@ -1,0 +1,37 @@
+// Running stages in order: planning, dry runs, task lists, single tasks
+// (HPC array units) and full runs with J jobs at once, resuming done jobs.
+#pragma once
+
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "config/case_config.h"
+#include "stages/stage.h"
+
+namespace mill {
+
+// Exit statuses of orchestrate.
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitFailed = 1,          // a job or engine run failed
+  kExitBadInput = 2,        // bad case file, ore card or command line
+  kExitNotImplemented = 3,  // a requested stage is not implemented yet
+};
+
+struct Invocation {
+  std::vector<std::string> stages;  // in pipeline order
+  RunOptions opts;
+  bool dry_run = false;
+  bool list_tasks = false;
+  std::optional<int> task;  // run only job I of the (single) stage
+};
+
+// Run the invocation; returns an ExitCode (or 128+signal when interrupted).
+int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostream& out);
+
+// Expand "all" to every stage, validate names (ConfigError naming --stage).
+std::vector<std::string> resolve_stages(const std::string& stage);
+
+}  // namespace mill

@@ -1,0 +1,132 @@
+// Progress reporting for stages and jobs.
+#include "progress.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace mill {
+
+Progress::Progress(std::ostream& out, bool tty, double heartbeat_seconds)
+    : out_(out), tty_(tty), heartbeat_(heartbeat_seconds) {}
+
+std::string Progress::duration(double s) {
+  if (!std::isfinite(s) || s < 0) return "?";
+  const long t = std::lround(s);
+  if (t < 60) return fmt::format("{}s", t);
+  if (t < 3600) return fmt::format("{}m {:02}s", t / 60, t % 60);
+  return fmt::format("{}h {:02}m", t / 3600, (t % 3600) / 60);
+}
+
+void Progress::clear_line() {
+  if (tty_ && line_open_) {
+    out_ << "\r\033[K";
+    line_open_ = false;
+  }
+}
+
+std::string Progress::status_text() const {
+  std::string s = fmt::format("[{}] {}/{} jobs done", stage_, done_ + skipped_, total_);
+  if (failed_) s += fmt::format(", {} failed", failed_);
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - stage_t0_).count();
+  // ETA: mean wall time of the jobs run so far, times what is left, over the
+  // jobs running at once; a running job counts by its reported fraction.
+  double work_done = done_;
+  for (const auto& [label, st] : running_)
+    if (st.second > 0) work_done += std::min(st.second, 1.0);
+  const int left = total_ - done_ - skipped_ - failed_;
+  if (work_done > 0.05 && left > 0) {
+    const double per_job = elapsed / work_done * std::max<size_t>(1, running_.size());
+    const double remaining = (left - (work_done - done_)) * per_job / std::max<size_t>(1, running_.size());
+    s += ", ETA " + duration(remaining);
+  }
+  for (const auto& [label, st] : running_) {
+    s += " | " + label;
+    if (!st.first.empty()) s += " " + st.first;
+  }
+  return s;
+}
+
+void Progress::draw(bool force) {
+  const auto now = std::chrono::steady_clock::now();
+  if (tty_) {
+    if (!force && now - last_draw_ < std::chrono::milliseconds(200)) return;
+    out_ << "\r\033[K" << status_text() << std::flush;
+    line_open_ = true;
+  } else {
+    if (!force && std::chrono::duration<double>(now - last_draw_).count() < heartbeat_) return;
+    out_ << status_text() << "\n" << std::flush;
+  }
+  last_draw_ = now;
+}
+
+void Progress::stage_begin(const std::string& stage, int total, int already_done) {
+  std::lock_guard<std::mutex> g(mu_);
+  clear_line();
+  stage_ = stage;
+  total_ = total;
+  skipped_ = already_done;
+  done_ = failed_ = 0;
+  job_seconds_ = 0;
+  running_.clear();
+  stage_t0_ = std::chrono::steady_clock::now();
+  out_ << fmt::format("== stage {}: {} job{}, {} already done\n", stage, total, total == 1 ? "" : "s", already_done)
+       << std::flush;
+  last_draw_ = {};
+}
+
+void Progress::job_begin(const std::string& label) {
+  std::lock_guard<std::mutex> g(mu_);
+  running_[label] = {"", -1};
+  started_[label] = std::chrono::steady_clock::now();
+  clear_line();
+  if (!tty_) out_ << fmt::format("[{}] start {}\n", stage_, label) << std::flush;
+  draw(true);
+}
+
+void Progress::job_step(const std::string& label, const std::string& what, double fraction) {
+  std::lock_guard<std::mutex> g(mu_);
+  running_[label] = {what, fraction};
+  draw(false);
+}
+
+void Progress::job_end(const std::string& label, bool ok, double seconds) {
+  std::lock_guard<std::mutex> g(mu_);
+  running_.erase(label);
+  started_.erase(label);
+  if (ok) {
+    ++done_;
+    job_seconds_ += seconds;
+  } else {
+    ++failed_;
+  }
+  clear_line();
+  out_ << fmt::format("[{}] {} {} in {} ({}/{})\n", stage_, ok ? "done" : "FAILED", label, duration(seconds),
+                      done_ + skipped_, total_)
+       << std::flush;
+  draw(true);
+}
+
+void Progress::stage_end() {
+  std::lock_guard<std::mutex> g(mu_);
+  clear_line();
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - stage_t0_).count();
+  out_ << fmt::format("== stage {} finished: {} run, {} skipped (done before), {} failed, {}\n", stage_, done_,
+                      skipped_, failed_, duration(elapsed))
+       << std::flush;
+}
+
+void Progress::info(const std::string& line) {
+  std::lock_guard<std::mutex> g(mu_);
+  clear_line();
+  out_ << line << "\n" << std::flush;
+}
+
+void Progress::warn(const std::string& line) {
+  std::lock_guard<std::mutex> g(mu_);
+  clear_line();
+  out_ << "warning: " << line << "\n" << std::flush;
+}
+
+}  // namespace mill

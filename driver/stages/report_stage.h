@@ -1,0 +1,17 @@
+// Stage 'report': the HTML report and headline numbers
+#pragma once
+
+#include "stages/stage.h"
+
+namespace mill {
+
+class ReportStage : public Stage {
+ public:
+  std::string name() const override { return "report"; }
+  std::string description() const override { return "the HTML report and headline numbers"; }
+  bool implemented() const override { return false; }
+  Plan plan(const StageContext& ctx) const override;
+  void run_job(StageContext& ctx, const JobSpec& job, const std::filesystem::path& job_dir) override;
+};
+
+}  // namespace mill

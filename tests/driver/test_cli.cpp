@@ -1,0 +1,118 @@
+// The orchestrate program as a user meets it: help, bad input, plans, tasks.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Out {
+  int status;
+  std::string text;  // stdout and stderr
+};
+
+// Run orchestrate with arguments in a scratch folder; capture output and status.
+Out orchestrate(const std::string& args) {
+  static const fs::path cwd = [] {
+    fs::path d = fs::temp_directory_path() / ("mill_cli_" + std::to_string(getpid()));
+    fs::create_directories(d);
+    return d;
+  }();
+  const std::string cmd = "cd '" + cwd.string() + "' && '" + std::string(ORCHESTRATE_EXE) + "' " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string text;
+  std::array<char, 4096> buf{};
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) text.append(buf.data(), n);
+  int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, text};
+}
+
+const std::string kProject = MILL_PROJECT_DIR;
+const std::string kData = MILL_TEST_DATA;
+
+TEST(Cli, HelpHasExamples) {
+  auto o = orchestrate("--help");
+  EXPECT_EQ(o.status, 0);
+  EXPECT_NE(o.text.find("Examples:"), std::string::npos);
+  EXPECT_NE(o.text.find("--list-tasks"), std::string::npos);
+  EXPECT_NE(o.text.find("--task"), std::string::npos);
+}
+
+TEST(Cli, Version) {
+  auto o = orchestrate("--version");
+  EXPECT_EQ(o.status, 0);
+  EXPECT_NE(o.text.find("orchestrate "), std::string::npos);
+}
+
+TEST(Cli, UnknownStageSuggests) {
+  auto o = orchestrate("--stage breakge --dry-run");
+  EXPECT_EQ(o.status, 2);
+  EXPECT_NE(o.text.find("did you mean 'breakage'"), std::string::npos) << o.text;
+}
+
+TEST(Cli, BadCaseExitsTwoNamingKey) {
+  auto o = orchestrate("--case " + kData + "/bad_unknown_key.yaml --stage all --dry-run");
+  EXPECT_EQ(o.status, 2);
+  EXPECT_NE(o.text.find("rotor.rmp"), std::string::npos) << o.text;
+  EXPECT_FALSE(fs::exists(fs::temp_directory_path() / ("mill_cli_" + std::to_string(getpid())) / "runs" / "bad"));
+}
+
+TEST(Cli, MissingCaseFile) {
+  auto o = orchestrate("--case /nonexistent/case.yaml --stage all");
+  EXPECT_EQ(o.status, 2);
+  EXPECT_NE(o.text.find("/nonexistent/case.yaml"), std::string::npos);
+}
+
+TEST(Cli, UnknownOptionExitsTwo) {
+  auto o = orchestrate("--stagez all");
+  EXPECT_EQ(o.status, 2);
+}
+
+TEST(Cli, DryRunListsEveryStageOfBothCases) {
+  for (const char* c : {"default", "reference"}) {
+    auto o = orchestrate("--case " + kProject + "/cases/" + c + ".yaml --stage all --dry-run");
+    EXPECT_EQ(o.status, 0) << o.text;
+    for (const char* s : {"stage flow", "stage sample", "stage transport", "stage calibrate", "stage breakage",
+                          "stage report"})
+      EXPECT_NE(o.text.find(s), std::string::npos) << c << ": " << s << "\n" << o.text;
+    EXPECT_NE(o.text.find("rpm2000"), std::string::npos);
+    EXPECT_NE(o.text.find("v169_a90_r0"), std::string::npos);
+  }
+  auto ref = orchestrate("--case " + kProject + "/cases/reference.yaml --stage breakage --dry-run");
+  EXPECT_NE(ref.text.find("39 jobs"), std::string::npos) << ref.text;  // 13 speeds x 3 repeats
+}
+
+TEST(Cli, ListTasksOneLinePerJob) {
+  auto o = orchestrate("--case " + kData + "/good_small.yaml --stage breakage --list-tasks");
+  EXPECT_EQ(o.status, 0);
+  int lines = 0;
+  for (char ch : o.text) lines += ch == '\n';
+  EXPECT_EQ(lines, 4) << o.text;  // 2 speeds x 2 repeats
+  EXPECT_EQ(o.text.rfind("0\tv5_a90_r0\t", 0), 0u) << o.text;
+}
+
+TEST(Cli, TaskOutOfRange) {
+  auto o = orchestrate("--case " + kData + "/good_small.yaml --stage breakage --task 99");
+  EXPECT_EQ(o.status, 2);
+  EXPECT_NE(o.text.find("--task"), std::string::npos);
+}
+
+TEST(Cli, TaskNeedsOneStage) {
+  auto o = orchestrate("--stage all --task 0");
+  EXPECT_EQ(o.status, 2);
+}
+
+TEST(Cli, PrintSchema) {
+  auto o = orchestrate("--print-schema");
+  EXPECT_EQ(o.status, 0);
+  EXPECT_NE(o.text.find("breakage.velocities"), std::string::npos);
+}
+
+}  // namespace

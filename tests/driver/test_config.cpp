@@ -1,0 +1,137 @@
+// Case-file and ore-card validation: every bad file names its key and line.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "config/case_config.h"
+#include "config/schema.h"
+
+namespace fs = std::filesystem;
+using mill::config::ConfigError;
+using mill::config::load_case;
+
+namespace {
+
+const fs::path kData = MILL_TEST_DATA;
+const fs::path kProject = MILL_PROJECT_DIR;
+
+// Load a bad case and return the error text (fails the test if none).
+std::string error_of(const std::string& file) {
+  try {
+    load_case(kData / file, kProject);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << file << " was accepted";
+  return "";
+}
+
+struct BadCase {
+  const char* file;
+  std::vector<std::string> must_contain;  // key, line, value, expectation
+};
+
+// Short test names in CTest output.
+void PrintTo(const BadCase& c, std::ostream* os) { *os << c.file; }
+
+class BadCaseTest : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadCaseTest, MessageNamesKeyAndLine) {
+  const BadCase& c = GetParam();
+  const std::string msg = error_of(c.file);
+  for (const auto& s : c.must_contain) EXPECT_NE(msg.find(s), std::string::npos) << "missing '" << s << "' in: " << msg;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Files, BadCaseTest,
+    ::testing::Values(
+        BadCase{"bad_unknown_key.yaml", {"bad_unknown_key.yaml:3:", "rotor.rmp", "unknown key", "did you mean 'rotor.rpm'"}},
+        BadCase{"bad_unknown_section.yaml", {":2:", "breakge", "did you mean 'breakage'"}},
+        BadCase{"bad_wrong_type.yaml", {":3:", "lump.n_elements", "'many'", "integer >= 2"}},
+        BadCase{"bad_negative_velocity.yaml", {":3:", "breakage.velocities[2]", "-3", "> 0 m/s"}},
+        BadCase{"bad_choice.yaml", {":3:", "gas.model", "'supersonic'", "one of incompressible, compressible"}},
+        BadCase{"bad_angle_range.yaml", {":3:", "breakage.angles[1]", "120", "(0, 90] deg"}},
+        BadCase{"bad_missing_ore.yaml", {":3:", "ore.card", "unobtainium.yaml", "not found", "sandstone"}},
+        BadCase{"bad_hub_too_big.yaml", {":5:", "mill.flywheel.hub_diameter", "1.2", "less than mill.flywheel.diameter"}},
+        BadCase{"bad_section_is_scalar.yaml", {":2:", "mill", "expected a section"}},
+        BadCase{"bad_not_yaml.yaml", {"bad_not_yaml.yaml:", "not valid YAML"}},
+        BadCase{"bad_edges_order.yaml", {":3:", "breakage.size_fraction_edges", "ascending", "0.1 after 0.2"}},
+        BadCase{"bad_bool.yaml", {":3:", "sample.turbulence", "'maybe'", "true or false"}},
+        BadCase{"bad_int_float.yaml", {":3:", "injection.n_lumps", "'36.5'", "integer"}},
+        BadCase{"bad_flywheel_too_tall.yaml", {":4:", "mill.flywheel.axis_height", "0.3", "must fit"}},
+        BadCase{"bad_ore_ucs.yaml", {"bad_ore_ucs_card.yaml:5:", "ucs", "tensile_strength"}},
+        BadCase{"bad_ore_nu.yaml", {"bad_ore_nu_card.yaml:4:", "poisson_ratio", "0.5", "[0, 0.5)"}},
+        BadCase{"bad_ore_negative_E.yaml", {"bad_ore_negative_E_card.yaml:3:", "youngs_modulus", "-10.0e9", "> 0 Pa"}},
+        BadCase{"bad_ore_missing_key.yaml", {"bad_ore_missing_key_card.yaml", "ucs", "required key is missing"}}),
+    [](const auto& info) {
+      std::string n = info.param.file;
+      n = n.substr(0, n.find('.'));
+      for (auto& ch : n)
+        if (!isalnum(static_cast<unsigned char>(ch))) ch = '_';
+      return n;
+    });
+
+// The *_card.yaml files are ore cards: load them through a case that points at them.
+TEST(OreCard, BadCardsAreRejectedThroughTheCase) {
+  for (const char* f : {"bad_ore_ucs.yaml", "bad_ore_nu.yaml", "bad_ore_negative_E.yaml", "bad_ore_missing_key.yaml"}) {
+    const std::string msg = error_of(f);
+    EXPECT_NE(msg.find("_card.yaml"), std::string::npos) << f << ": " << msg;
+  }
+}
+
+TEST(CaseFile, BundledCasesAreValid) {
+  for (const char* f : {"cases/default.yaml", "cases/reference.yaml"}) {
+    const auto c = load_case(kProject / f, kProject);
+    EXPECT_FALSE(c.name.empty());
+    EXPECT_EQ(c.ore.str("name"), "sandstone");
+  }
+  const auto ref = load_case(kProject / "cases/reference.yaml", kProject);
+  EXPECT_EQ(ref.doc.integer("lump.n_elements"), 3344);
+  EXPECT_EQ(ref.doc.integer("injection.n_lumps"), 360);
+  EXPECT_DOUBLE_EQ(ref.doc.reals("breakage.velocities").front(), 4.0);
+  EXPECT_DOUBLE_EQ(ref.doc.reals("breakage.velocities").back(), 169.0);
+}
+
+TEST(CaseFile, GraniteCardIsValid) {
+  const auto ore = mill::config::Document::load(kProject / "liggghts_inputs/materials/granite.yaml",
+                                                mill::config::ore_schema());
+  mill::config::check_ore(ore);
+  EXPECT_GT(ore.real("ucs") / ore.real("tensile_strength"), 10.0);
+}
+
+TEST(CaseFile, DefaultsFillAbsentKeysAndLinesAreKept) {
+  const auto c = load_case(kData / "good_small.yaml", kProject);
+  EXPECT_EQ(c.doc.integer("lump.n_elements"), 200);
+  EXPECT_EQ(c.doc.line("lump.n_elements"), 3);
+  EXPECT_EQ(c.doc.line("mill.housing.height"), 0);  // default
+  EXPECT_DOUBLE_EQ(c.doc.real("mill.housing.height"), 4.0);
+  EXPECT_EQ(c.doc.reals("rotor.rpm").size(), 2u);
+}
+
+TEST(CaseFile, CanonicalJsonIsStable) {
+  const auto a = load_case(kData / "good_small.yaml", kProject);
+  const auto b = load_case(kData / "good_small.yaml", kProject);
+  EXPECT_EQ(a.doc.to_json().dump(), b.doc.to_json().dump());
+}
+
+TEST(Schema, MarkdownListsEveryKeyWithUnit) {
+  const std::string md = mill::config::schema_markdown();
+  for (const auto& k : mill::config::case_schema().keys) EXPECT_NE(md.find("`" + k.path + "`"), std::string::npos) << k.path;
+  EXPECT_NE(md.find("| `rotor.rpm` | list of numbers | rpm |"), std::string::npos);
+}
+
+TEST(Schema, DocsConfigIsUpToDate) {
+  std::ifstream in(kProject / "docs" / "config.md");
+  ASSERT_TRUE(in) << "docs/config.md is missing: regenerate with orchestrate --print-schema > docs/config.md";
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, mill::config::schema_markdown())
+      << "docs/config.md is stale: regenerate with orchestrate --print-schema > docs/config.md";
+}
+
+TEST(EditDistance, Basics) {
+  EXPECT_EQ(mill::config::edit_distance("rpm", "rmp"), 2u);
+  EXPECT_EQ(mill::config::edit_distance("", "abc"), 3u);
+  EXPECT_EQ(mill::config::edit_distance("same", "same"), 0u);
+}
+
+}  // namespace

@@ -1,0 +1,138 @@
+// The engine runner: failures surface log and status; signals reach children.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <thread>
+
+#include "engine/runner.h"
+
+namespace fs = std::filesystem;
+using namespace mill::engine;
+
+namespace {
+
+fs::path fresh_dir(const std::string& name) {
+  fs::path d = fs::temp_directory_path() / ("mill_runner_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+Command sh(const fs::path& dir, const std::string& script, Engine e = Engine::Generic) {
+  Command c;
+  c.argv = {"/bin/sh", "-c", script};
+  c.cwd = dir;
+  c.log = dir / "log.txt";
+  c.engine = e;
+  c.job = "test/job";
+  return c;
+}
+
+TEST(Runner, SuccessReturnsZeroAndWritesLog) {
+  const auto d = fresh_dir("ok");
+  Runner r;
+  auto res = r.run(sh(d, "echo hello from child"));
+  EXPECT_EQ(res.exit_code, 0);
+  std::ifstream in(d / "log.txt");
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "hello from child");
+}
+
+TEST(Runner, FailingChildSurfacesLogPathAndExitStatus) {
+  const auto d = fresh_dir("fail");
+  Runner r;
+  try {
+    r.run(sh(d, "echo line one; echo the last words; exit 3"));
+    FAIL() << "no error";
+  } catch (const EngineError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("exit status 3"), std::string::npos) << m;
+    EXPECT_NE(m.find((d / "log.txt").string()), std::string::npos) << m;
+    EXPECT_NE(m.find("the last words"), std::string::npos) << m;
+    EXPECT_NE(m.find("test/job"), std::string::npos) << m;
+    EXPECT_EQ(e.result.exit_code, 3);
+  }
+}
+
+TEST(Runner, EngineErrorLineFailsEvenWithExitZero) {
+  const auto d = fresh_dir("errline");
+  Runner r;
+  EXPECT_THROW(r.run(sh(d, "echo 'ERROR: Illegal fix style'; exit 0", Engine::Liggghts)), EngineError);
+  EXPECT_THROW(r.run(sh(d, "echo '--> FOAM FATAL ERROR: cannot find file'; exit 0", Engine::OpenFoam)), EngineError);
+  EXPECT_NO_THROW(r.run(sh(d, "echo 'no error here'; exit 0", Engine::Liggghts)));
+}
+
+TEST(Runner, MissingProgramIsAClearError) {
+  const auto d = fresh_dir("missing");
+  Command c = sh(d, "");
+  c.argv = {"no-such-engine-xyz"};
+  try {
+    Runner().run(c);
+    FAIL();
+  } catch (const EngineError& e) {
+    EXPECT_NE(std::string(e.what()).find("no-such-engine-xyz"), std::string::npos);
+  }
+}
+
+TEST(Runner, MpirunPrefixWhenMoreThanOneRank) {
+  Command c;
+  c.argv = {"liggghts-mill", "-in", "x.in"};
+  c.np = 2;
+  auto a = Runner::full_argv(c);
+  ASSERT_GE(a.size(), 3u);
+  EXPECT_EQ(a[0], "mpirun");
+  EXPECT_EQ(a[2], "2");
+  const bool root_flag = std::find(a.begin(), a.end(), "--allow-run-as-root") != a.end();
+  EXPECT_EQ(root_flag, geteuid() == 0);
+  c.np = 1;
+  EXPECT_EQ(Runner::full_argv(c)[0], "liggghts-mill");
+}
+
+TEST(Runner, EnvironmentReachesChild) {
+  const auto d = fresh_dir("env");
+  Command c = sh(d, "echo \"$MILL_TEST_VAR\"");
+  c.env["MILL_TEST_VAR"] = "forty-two";
+  Runner().run(c);
+  std::ifstream in(d / "log.txt");
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "forty-two");
+}
+
+// SIGTERM to orchestrate is forwarded to the engine, which sees it (trap),
+// and run() reports the interruption. Done in a forked process so that the
+// signal state of the test binary stays clean.
+TEST(Runner, SigtermReachesTheChild) {
+  const auto d = fresh_dir("sigterm");
+  const fs::path marker = d / "got_term";
+  pid_t pid = fork();
+  if (pid == 0) {
+    install_signal_forwarding();
+    try {
+      Runner().run(sh(d, "trap 'echo TERM > " + marker.string() + "; exit 0' TERM; echo ready; "
+                         "while true; do sleep 0.05; done"));
+    } catch (const Interrupted& e) {
+      _exit(e.signal == SIGTERM ? 42 : 43);
+    } catch (...) {
+      _exit(44);
+    }
+    _exit(45);
+  }
+  // Wait until the child's shell is up, then terminate orchestrate's stand-in.
+  for (int i = 0; i < 100 && !fs::exists(d / "log.txt"); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  kill(pid, SIGTERM);
+  int st = 0;
+  waitpid(pid, &st, 0);
+  ASSERT_TRUE(WIFEXITED(st));
+  EXPECT_EQ(WEXITSTATUS(st), 42);
+  EXPECT_TRUE(fs::exists(marker)) << "the engine never saw SIGTERM";
+}
+
+}  // namespace
