@@ -1,0 +1,577 @@
+// Per-impact analysis and its CSV and HDF5 outputs; see breakage_results.h.
+#include "postprocess/breakage_results.h"
+
+#include <fmt/format.h>
+#include <hdf5.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <set>
+#include <sstream>
+#include <type_traits>
+#include <utility>
+
+#include "postprocess/lammps_dump.h"
+
+namespace mill::post {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kJoulePerKgPerKWhPerTonne = 3600.0;  // 1 kWh/t = 3.6e6 J / 1e3 kg
+constexpr const char* kFormat = "mill-breakage-1";
+
+// One summary column: name, unit, whether it is an integer, and accessors.
+struct Column {
+  const char* name;
+  const char* unit;
+  bool integer;
+  std::function<double(const ImpactSummary&)> get;
+  std::function<void(ImpactSummary&, double)> set;
+};
+
+// A column bound to a field of ImpactSummary; integer unless the field is real.
+template <typename T>
+Column MakeColumn(const char* name, const char* unit, T ImpactSummary::*field) {
+  constexpr bool kInteger = !std::is_floating_point_v<T>;
+  return {name, unit, kInteger,
+          [field](const ImpactSummary& s) { return static_cast<double>(s.*field); },
+          [field](ImpactSummary& s, double v) {
+            if constexpr (kInteger) {
+              s.*field = static_cast<T>(std::llround(v));
+            } else {
+              s.*field = v;
+            }
+          }};
+}
+
+// The summary columns, in CSV order; the first 13 are the required ones.
+const std::vector<Column>& Columns() {
+  using S = ImpactSummary;
+  static const std::vector<Column> columns = {
+      MakeColumn("velocity_m_s", "m/s", &S::velocity_m_s),
+      MakeColumn("angle_deg", "deg", &S::angle_deg),
+      MakeColumn("repeat", "1", &S::repeat),
+      MakeColumn("n_elements", "1", &S::n_elements),
+      MakeColumn("n_pieces", "1", &S::n_pieces),
+      MakeColumn("n_single", "1", &S::n_single),
+      MakeColumn("n_multi", "1", &S::n_multi),
+      MakeColumn("largest_mass_fraction", "1", &S::largest_mass_fraction),
+      MakeColumn("single_mass_fraction", "1", &S::single_mass_fraction),
+      MakeColumn("broken_bond_fraction", "1", &S::broken_bond_fraction),
+      MakeColumn("specific_energy_J_kg", "J/kg", &S::specific_energy_J_kg),
+      MakeColumn("t10_percent", "%", &S::t10_percent),
+      MakeColumn("wall_seconds", "s", &S::wall_seconds),
+      MakeColumn("specific_energy_kWh_t", "kWh/t", &S::specific_energy_kWh_t),
+      MakeColumn("lump_mass_kg", "kg", &S::lump_mass_kg),
+      MakeColumn("lump_diameter_m", "m", &S::lump_diameter_m),
+      MakeColumn("density_kg_m3", "kg/m3", &S::density_kg_m3),
+      MakeColumn("initial_bonds", "1", &S::initial_bonds),
+      MakeColumn("intact_bonds", "1", &S::intact_bonds),
+      MakeColumn("element_d_rel_max", "1", &S::element_d_rel_max),
+      MakeColumn("t10_resolved", "1", &S::t10_resolved),
+  };
+  return columns;
+}
+
+constexpr std::size_t kRequiredColumns = 13;
+
+// Formats a value for CSV: integers plainly, reals in shortest round-trip form.
+std::string CsvValue(const Column& c, const ImpactSummary& s) {
+  const double v = c.get(s);
+  return c.integer ? fmt::format("{}", std::llround(v)) : fmt::format("{}", v);
+}
+
+// Joins strings with commas.
+std::string JoinCsv(const std::vector<std::string>& cells) {
+  std::string out;
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    if (k) out += ',';
+    out += cells[k];
+  }
+  return out;
+}
+
+// Splits one CSV line on commas (the files hold numbers and names only).
+std::vector<std::string> SplitCsv(const std::string& line) {
+  std::vector<std::string> cells;
+  std::string cell;
+  std::istringstream ss(line);
+  while (std::getline(ss, cell, ',')) cells.push_back(cell);
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  return cells;
+}
+
+// Appends rows to a CSV with the given header: copies the existing file (whose
+// header must match) plus the rows to path.tmp, then renames it over path.
+void AppendCsvRows(const std::string& path, const std::string& header,
+                   const std::vector<std::string>& rows) {
+  std::string existing;
+  if (fs::exists(path)) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw PostError(fmt::format("{}: cannot read", path));
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    existing = ss.str();
+    const std::string first = existing.substr(0, existing.find('\n'));
+    if (!existing.empty() && first != header) {
+      throw PostError(fmt::format(
+          "{}: header is '{}', expected '{}' (a file from another version? move it away)", path,
+          first, header));
+    }
+    if (!existing.empty() && existing.back() != '\n') existing += '\n';
+  }
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw PostError(fmt::format("{}: cannot write", tmp));
+    if (existing.empty()) {
+      out << header << '\n';
+    } else {
+      out << existing;
+    }
+    for (const std::string& r : rows) out << r << '\n';
+    out.flush();
+    if (!out) {
+      out.close();
+      std::error_code ignored;
+      fs::remove(tmp, ignored);
+      throw PostError(fmt::format("{}: write failed (disk full?)", tmp));
+    }
+  }
+  fs::rename(tmp, path);
+}
+
+// Owns an HDF5 id and closes it with the matching H5*close.
+class H5Id {
+ public:
+  H5Id(hid_t id, herr_t (*close)(hid_t), const std::string& what) : id_(id), close_(close) {
+    if (id_ < 0) throw PostError(fmt::format("HDF5: {} failed", what));
+  }
+  H5Id(const H5Id&) = delete;
+  H5Id& operator=(const H5Id&) = delete;
+  ~H5Id() {
+    if (id_ >= 0) close_(id_);
+  }
+  operator hid_t() const { return id_; }
+
+ private:
+  hid_t id_;
+  herr_t (*close_)(hid_t);
+};
+
+// Silences HDF5's own error printing for the scope; errors become PostError.
+class H5Quiet {
+ public:
+  H5Quiet() {
+    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
+  ~H5Quiet() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
+
+ private:
+  H5E_auto2_t func_ = nullptr;
+  void* data_ = nullptr;
+};
+
+// Throws with `what` if an HDF5 call returned a negative status.
+void H5Check(herr_t status, const std::string& what) {
+  if (status < 0) throw PostError(fmt::format("HDF5: {} failed", what));
+}
+
+// Attaches a scalar string attribute to an object.
+void WriteStringAttr(hid_t obj, const char* name, const std::string& value) {
+  H5Id type(H5Tcopy(H5T_C_S1), H5Tclose, "string type");
+  H5Check(H5Tset_size(type, std::max<std::size_t>(1, value.size())), "string size");
+  H5Check(H5Tset_strpad(type, H5T_STR_NULLTERM), "string pad");
+  H5Id space(H5Screate(H5S_SCALAR), H5Sclose, "scalar space");
+  H5Id attr(H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
+            fmt::format("attribute {}", name));
+  const std::string padded = value.empty() ? std::string(1, '\0') : value;
+  H5Check(H5Awrite(attr, type, padded.data()), fmt::format("writing attribute {}", name));
+}
+
+// Attaches a scalar numeric attribute (double or int64) to an object.
+void WriteNumberAttr(hid_t obj, const char* name, double value, bool integer) {
+  H5Id space(H5Screate(H5S_SCALAR), H5Sclose, "scalar space");
+  const hid_t file_type = integer ? H5T_STD_I64LE : H5T_IEEE_F64LE;
+  H5Id attr(H5Acreate2(obj, name, file_type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
+            fmt::format("attribute {}", name));
+  if (integer) {
+    const long long v = std::llround(value);
+    H5Check(H5Awrite(attr, H5T_NATIVE_LLONG, &v), fmt::format("writing attribute {}", name));
+  } else {
+    H5Check(H5Awrite(attr, H5T_NATIVE_DOUBLE, &value), fmt::format("writing attribute {}", name));
+  }
+}
+
+// Reads a scalar numeric attribute as double.
+double ReadNumberAttr(hid_t obj, const char* name, const std::string& where) {
+  if (H5Aexists(obj, name) <= 0) {
+    throw PostError(fmt::format("{}: attribute '{}' is missing", where, name));
+  }
+  H5Id attr(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose, fmt::format("{} attribute {}", where, name));
+  double v = 0.0;
+  H5Check(H5Aread(attr, H5T_NATIVE_DOUBLE, &v), fmt::format("{}: reading {}", where, name));
+  return v;
+}
+
+// Writes a 1-D or 2-D dataset of doubles or int64 with its `unit` attribute.
+template <typename T>
+void WriteDataset(hid_t loc, const char* name, const std::vector<T>& data,
+                  std::vector<hsize_t> dims, const char* unit) {
+  static_assert(std::is_same_v<T, double> || std::is_same_v<T, long long>);
+  const bool is_int = std::is_same_v<T, long long>;
+  H5Id space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose,
+             fmt::format("dataspace of {}", name));
+  H5Id set(H5Dcreate2(loc, name, is_int ? H5T_STD_I64LE : H5T_IEEE_F64LE, space, H5P_DEFAULT,
+                      H5P_DEFAULT, H5P_DEFAULT),
+           H5Dclose, fmt::format("dataset {}", name));
+  if (!data.empty()) {
+    H5Check(H5Dwrite(set, is_int ? H5T_NATIVE_LLONG : H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL,
+                     H5P_DEFAULT, data.data()),
+            fmt::format("writing {}", name));
+  }
+  WriteStringAttr(set, "unit", unit);
+}
+
+// Creates an HDF5 group.
+hid_t MakeGroup(hid_t loc, const std::string& name) {
+  return H5Gcreate2(loc, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+}
+
+// Writes the /summary/<column> datasets for a list of summaries.
+void WriteSummaryGroup(hid_t file, const std::vector<ImpactSummary>& rows) {
+  H5Id group(MakeGroup(file, "summary"), H5Gclose, "group /summary");
+  const std::vector<hsize_t> dims = {rows.size()};
+  for (const Column& c : Columns()) {
+    if (c.integer) {
+      std::vector<long long> v;
+      for (const auto& r : rows) v.push_back(std::llround(c.get(r)));
+      WriteDataset(group, c.name, v, dims, c.unit);
+    } else {
+      std::vector<double> v;
+      for (const auto& r : rows) v.push_back(c.get(r));
+      WriteDataset(group, c.name, v, dims, c.unit);
+    }
+  }
+}
+
+// Writes one impact's group under /impacts.
+void WriteImpactGroup(hid_t impacts, const ImpactResult& r) {
+  const std::string name =
+      ImpactGroupName({r.summary.velocity_m_s, r.summary.angle_deg, r.summary.repeat});
+  H5Id g(MakeGroup(impacts, name), H5Gclose, fmt::format("group /impacts/{}", name));
+  const hsize_t n = r.fragments.size();
+  std::vector<long long> count;
+  std::vector<double> mass, diameter, d_rel, velocity;
+  const double d_ref = EquivalentDiameter(r.summary.lump_mass_kg, r.summary.density_kg_m3);
+  for (const Fragment& f : r.fragments) {
+    count.push_back(static_cast<long long>(f.n_elements()));
+    mass.push_back(f.mass);
+    diameter.push_back(f.diameter);
+    d_rel.push_back(f.diameter / d_ref);
+    velocity.insert(velocity.end(), f.velocity.begin(), f.velocity.end());
+  }
+  WriteDataset(g, "n_elements", count, {n}, "1");
+  WriteDataset(g, "mass", mass, {n}, "kg");
+  WriteDataset(g, "diameter", diameter, {n}, "m");
+  WriteDataset(g, "d_rel", d_rel, {n}, "1");
+  WriteDataset(g, "velocity", velocity, {n, 3}, "m/s");
+  WriteDataset(g, "fraction_edges", r.fraction_edges, {r.fraction_edges.size()}, "1");
+  WriteDataset(g, "fraction_mass", r.fraction_mass, {r.fraction_mass.size()}, "1");
+  for (const Column& c : Columns()) WriteNumberAttr(g, c.name, c.get(r.summary), c.integer);
+  std::string warnings;
+  for (const auto& w : r.warnings) warnings += (warnings.empty() ? "" : "\n") + w;
+  WriteStringAttr(g, "warnings", warnings);
+  WriteStringAttr(g, "diameter_definition",
+                  "equal-volume sphere of the solid: d = (6 m / (pi rho))^(1/3)");
+}
+
+// Creates (or truncates) an HDF5 file for writing.
+hid_t CreateTmpFile(const std::string& tmp) {
+  const hid_t file = H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  if (file < 0) throw PostError(fmt::format("{}: cannot create HDF5 file", tmp));
+  return file;
+}
+
+}  // namespace
+
+// Group name with the velocity to 0.1 m/s when that is exact, else in full.
+std::string ImpactGroupName(const ImpactConditions& c) {
+  const double tenth = std::round(c.velocity_m_s * 10.0) / 10.0;
+  const std::string v = tenth == c.velocity_m_s ? fmt::format("{:.1f}", c.velocity_m_s)
+                                                : fmt::format("{}", c.velocity_m_s);
+  return fmt::format("v{}_a{}_r{}", v, c.angle_deg, c.repeat);
+}
+
+// Per-impact analysis.
+ImpactResult AnalyseImpact(const std::vector<Element>& elements, const std::vector<Bond>& bonds,
+                           const ImpactSpec& spec, const std::string& bond_source) {
+  if (elements.empty()) throw PostError("no elements to analyse (empty dump?)");
+  if (!(spec.lump_diameter_m > 0.0)) {
+    throw PostError(fmt::format("lump diameter must be > 0 m, got {}", spec.lump_diameter_m));
+  }
+  if (spec.initial_bonds <= 0) {
+    throw PostError(fmt::format("initial number of bonds must be > 0, got {}", spec.initial_bonds));
+  }
+  if (!(spec.conditions.velocity_m_s >= 0.0)) {
+    throw PostError(
+        fmt::format("impact speed must be >= 0 m/s, got {}", spec.conditions.velocity_m_s));
+  }
+  ValidateFractionEdges(spec.fraction_edges);
+
+  std::set<std::pair<long long, long long>> unique;
+  for (const Bond& b : bonds) unique.emplace(std::min(b.i, b.j), std::max(b.i, b.j));
+  if (static_cast<long long>(unique.size()) > spec.initial_bonds) {
+    throw PostError(fmt::format("{}: {} intact bonds but only {} initial bonds (wrong lump?)",
+                                bond_source, unique.size(), spec.initial_bonds));
+  }
+
+  ImpactResult r;
+  r.fragments = FindFragments(elements, bonds, spec.density_kg_m3, bond_source);
+  r.fraction_edges = spec.fraction_edges;
+
+  ImpactSummary& s = r.summary;
+  s.velocity_m_s = spec.conditions.velocity_m_s;
+  s.angle_deg = spec.conditions.angle_deg;
+  s.repeat = spec.conditions.repeat;
+  s.n_elements = static_cast<long long>(elements.size());
+  s.n_pieces = static_cast<long long>(r.fragments.size());
+  s.lump_diameter_m = spec.lump_diameter_m;
+  s.density_kg_m3 = spec.density_kg_m3;
+  s.initial_bonds = spec.initial_bonds;
+  s.intact_bonds = static_cast<long long>(unique.size());
+  s.wall_seconds = spec.wall_seconds;
+
+  // Relative piece size d/D_solid, with D_solid the equal-volume diameter of
+  // the whole lump's solid: an intact lump is d/D = 1 whatever its packing
+  // density (a random packing fills ~60% of the nominal sphere).
+  for (const Fragment& f : r.fragments) s.lump_mass_kg += f.mass;
+  const double d_ref = EquivalentDiameter(s.lump_mass_kg, spec.density_kg_m3);
+  double single_mass = 0.0;
+  std::vector<double> d_rel, mass;
+  for (const Fragment& f : r.fragments) {
+    if (f.n_elements() == 1) {
+      ++s.n_single;
+      single_mass += f.mass;
+    } else {
+      ++s.n_multi;
+    }
+    d_rel.push_back(f.diameter / d_ref);
+    mass.push_back(f.mass);
+  }
+  s.largest_mass_fraction = r.fragments.front().mass / s.lump_mass_kg;
+  s.single_mass_fraction = single_mass / s.lump_mass_kg;
+  s.broken_bond_fraction =
+      1.0 - static_cast<double>(s.intact_bonds) / static_cast<double>(spec.initial_bonds);
+  s.specific_energy_J_kg = 0.5 * s.velocity_m_s * s.velocity_m_s;
+  s.specific_energy_kWh_t = s.specific_energy_J_kg / kJoulePerKgPerKWhPerTonne;
+  s.t10_percent = T10Percent(d_rel, mass);
+  r.fraction_mass = SizeFractionMass(d_rel, mass, spec.fraction_edges);
+
+  for (const Element& e : elements) {
+    s.element_d_rel_max = std::max(
+        s.element_d_rel_max, EquivalentDiameter(e.mass, spec.density_kg_m3) / d_ref);
+  }
+  s.t10_resolved = s.element_d_rel_max < 0.1;
+  if (!s.t10_resolved) {
+    r.warnings.push_back(fmt::format(
+        "t10 cannot resolve: the coarsest element has d/D = {:.4f} >= 0.1, so fully shredded "
+        "mass is not all counted as finer than D/10; use a finer lump (more elements) for t10",
+        s.element_d_rel_max));
+  }
+  return r;
+}
+
+// Per-impact analysis from files.
+ImpactResult AnalyseImpactFiles(const std::string& dump_path, const std::string& bond_path,
+                                const ImpactSpec& spec) {
+  const DumpSnapshot snap = ReadDumpLastSnapshot(dump_path, spec.density_kg_m3);
+  if (snap.elements.empty()) {
+    throw PostError(fmt::format("{}: step {} has no atoms", dump_path, snap.timestep));
+  }
+  const std::vector<Bond> bonds = ReadIntactBonds(bond_path);
+  return AnalyseImpact(snap.elements, bonds, spec, bond_path);
+}
+
+// summary.csv column names.
+const std::vector<std::string>& SummaryCsvColumns() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const Column& c : Columns()) n.push_back(c.name);
+    return n;
+  }();
+  return names;
+}
+
+// fractions.csv column names.
+const std::vector<std::string>& FractionsCsvColumns() {
+  static const std::vector<std::string> names = {"velocity_m_s",   "angle_deg", "repeat",
+                                                 "fraction_index", "d_low_rel", "d_high_rel",
+                                                 "mass_fraction"};
+  return names;
+}
+
+// One summary row.
+void AppendSummaryCsv(const std::string& path, const ImpactSummary& summary) {
+  std::vector<std::string> cells;
+  for (const Column& c : Columns()) cells.push_back(CsvValue(c, summary));
+  AppendCsvRows(path, JoinCsv(SummaryCsvColumns()), {JoinCsv(cells)});
+}
+
+// The impact's fraction rows.
+void AppendFractionsCsv(const std::string& path, const ImpactResult& result) {
+  if (result.fraction_edges.size() != result.fraction_mass.size() + 1) {
+    throw PostError(fmt::format("{}: {} edges do not bound {} fractions", path,
+                                result.fraction_edges.size(), result.fraction_mass.size()));
+  }
+  const ImpactSummary& s = result.summary;
+  std::vector<std::string> rows;
+  for (std::size_t k = 0; k < result.fraction_mass.size(); ++k) {
+    rows.push_back(fmt::format("{},{},{},{},{},{},{}", s.velocity_m_s, s.angle_deg, s.repeat, k,
+                               result.fraction_edges[k], result.fraction_edges[k + 1],
+                               result.fraction_mass[k]));
+  }
+  AppendCsvRows(path, JoinCsv(FractionsCsvColumns()), rows);
+}
+
+// summary.csv back into structs.
+std::vector<ImpactSummary> ReadSummaryCsv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw PostError(fmt::format("{}: cannot open summary file", path));
+  std::string line;
+  if (!std::getline(in, line)) throw PostError(fmt::format("{}: empty, expected a header", path));
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  const auto header = SplitCsv(line);
+  std::map<std::string, std::size_t> at;
+  for (std::size_t k = 0; k < header.size(); ++k) at.emplace(header[k], k);
+  const auto& cols = Columns();
+  std::vector<long> pos(cols.size(), -1);
+  for (std::size_t c = 0; c < cols.size(); ++c) {
+    auto it = at.find(cols[c].name);
+    if (it != at.end()) {
+      pos[c] = static_cast<long>(it->second);
+    } else if (c < kRequiredColumns) {
+      throw PostError(fmt::format("{}: header lacks required column '{}'", path, cols[c].name));
+    }
+  }
+  std::vector<ImpactSummary> rows;
+  long line_no = 1;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const auto cells = SplitCsv(line);
+    if (cells.size() != header.size()) {
+      throw PostError(fmt::format("{}:{}: {} values, header has {}", path, line_no, cells.size(),
+                                  header.size()));
+    }
+    ImpactSummary s;
+    for (std::size_t c = 0; c < cols.size(); ++c) {
+      if (pos[c] < 0) continue;
+      const std::string& cell = cells[static_cast<std::size_t>(pos[c])];
+      std::size_t used = 0;
+      double v = 0.0;
+      try {
+        v = std::stod(cell, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != cell.size()) {
+        throw PostError(fmt::format("{}:{}: {}: expected a number, got '{}'", path, line_no,
+                                    cols[c].name, cell));
+      }
+      cols[c].set(s, v);
+    }
+    rows.push_back(s);
+  }
+  return rows;
+}
+
+// breakage.h5 from in-memory results.
+void WriteBreakageH5(const std::string& path, const std::vector<ImpactResult>& results) {
+  H5Quiet quiet;
+  const std::string tmp = path + ".tmp";
+  std::set<std::string> names;
+  for (const auto& r : results) {
+    const std::string n =
+        ImpactGroupName({r.summary.velocity_m_s, r.summary.angle_deg, r.summary.repeat});
+    if (!names.insert(n).second) {
+      throw PostError(fmt::format("{}: impact {} appears twice in the results", path, n));
+    }
+  }
+  try {
+    H5Id file(CreateTmpFile(tmp), H5Fclose, "create");
+    WriteStringAttr(file, "format", kFormat);
+    H5Id impacts(MakeGroup(file, "impacts"), H5Gclose, "group /impacts");
+    std::vector<ImpactSummary> rows;
+    for (const auto& r : results) {
+      WriteImpactGroup(impacts, r);
+      rows.push_back(r.summary);
+    }
+    WriteSummaryGroup(file, rows);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw;
+  }
+  fs::rename(tmp, path);
+}
+
+// breakage.h5 merged from per-impact files.
+void MergeBreakageH5Files(const std::string& path, const std::vector<std::string>& inputs) {
+  H5Quiet quiet;
+  const std::string tmp = path + ".tmp";
+  try {
+    H5Id out(CreateTmpFile(tmp), H5Fclose, "create");
+    WriteStringAttr(out, "format", kFormat);
+    H5Id out_impacts(MakeGroup(out, "impacts"), H5Gclose, "group /impacts");
+    std::map<std::string, std::string> source_of;
+    std::vector<ImpactSummary> rows;
+    for (const std::string& in_path : inputs) {
+      const hid_t raw = H5Fopen(in_path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+      if (raw < 0) throw PostError(fmt::format("{}: cannot open as HDF5", in_path));
+      H5Id in(raw, H5Fclose, "open");
+      if (H5Lexists(in, "impacts", H5P_DEFAULT) <= 0) {
+        throw PostError(fmt::format("{}: no /impacts group (not a breakage.h5?)", in_path));
+      }
+      H5Id in_impacts(H5Gopen2(in, "impacts", H5P_DEFAULT), H5Gclose, "open /impacts");
+      H5G_info_t info;
+      H5Check(H5Gget_info(in_impacts, &info), "group info");
+      for (hsize_t k = 0; k < info.nlinks; ++k) {
+        const ssize_t len = H5Lget_name_by_idx(in_impacts, ".", H5_INDEX_NAME, H5_ITER_INC, k,
+                                               nullptr, 0, H5P_DEFAULT);
+        if (len < 0) throw PostError(fmt::format("{}: cannot list /impacts", in_path));
+        std::string name(static_cast<std::size_t>(len) + 1, '\0');
+        H5Lget_name_by_idx(in_impacts, ".", H5_INDEX_NAME, H5_ITER_INC, k, name.data(), name.size(),
+                           H5P_DEFAULT);
+        name.resize(static_cast<std::size_t>(len));
+        auto [it, fresh] = source_of.emplace(name, in_path);
+        if (!fresh) {
+          throw PostError(fmt::format("impact {} is in both {} and {}", name, it->second, in_path));
+        }
+        H5Check(
+            H5Ocopy(in_impacts, name.c_str(), out_impacts, name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+            fmt::format("copying /impacts/{} from {}", name, in_path));
+        H5Id g(H5Gopen2(in_impacts, name.c_str(), H5P_DEFAULT), H5Gclose, "open impact");
+        ImpactSummary s;
+        const std::string where = fmt::format("{}:/impacts/{}", in_path, name);
+        for (const Column& c : Columns()) c.set(s, ReadNumberAttr(g, c.name, where));
+        rows.push_back(s);
+      }
+    }
+    WriteSummaryGroup(out, rows);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw;
+  }
+  fs::rename(tmp, path);
+}
+
+}  // namespace mill::post

@@ -1,0 +1,62 @@
+// Size distributions of broken lumps and sweep-level measures: mass per size
+// fraction, t10, and the critical velocity. Used per impact and per sweep.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+namespace mill::post {
+
+// The reference grouping: 13 edges of relative piece size d/D, 12 fractions.
+std::vector<double> DefaultFractionEdges();
+
+// Checks edges: at least 2, finite, >= 0, strictly ascending. Throws PostError.
+void ValidateFractionEdges(const std::vector<double>& edges);
+
+// Mass fraction of pieces in each size fraction [edges[k], edges[k+1]), over
+// the total mass. A piece with d/D at or above the top edge goes into the top
+// fraction, one below the bottom edge into the bottom one, so the result sums
+// to 1 (for any positive total mass). `d_rel` and `mass` are per piece.
+std::vector<double> SizeFractionMass(const std::vector<double>& d_rel,
+                                     const std::vector<double>& mass,
+                                     const std::vector<double>& edges);
+
+// Exact mass fraction (0..1) of the pieces with d/D strictly below `cut`,
+// from the piece list itself (no interpolation across fraction edges).
+double MassFractionFinerThan(const std::vector<double>& d_rel, const std::vector<double>& mass,
+                             double cut);
+
+// t10: the mass percent of pieces finer than D/10, exact from the piece list.
+double T10Percent(const std::vector<double>& d_rel, const std::vector<double>& mass);
+
+// The velocity where y(v) first falls below `threshold`, walking up in
+// velocity and interpolating linearly between the last point at or above it
+// and the first point below it. Points are sorted by velocity here; several
+// values at one velocity are averaged first. If the first point is already
+// below, its velocity is returned (an upper bound). nullopt if never below.
+std::optional<double> FirstCrossingBelow(const std::vector<double>& velocity,
+                                         const std::vector<double>& y, double threshold);
+
+// One (velocity, repeat, largest piece fraction) point of a sweep at one angle.
+struct SweepPoint {
+  double velocity_m_s = 0.0;
+  int repeat = 0;
+  double value = 0.0;
+};
+
+// The critical velocity of a sweep: from the repeat-averaged curve, and its
+// spread over the repeats (each repeat's own curve).
+struct CriticalVelocity {
+  std::optional<double> of_mean_curve;            // m/s
+  std::vector<int> repeats;                       // repeat ids, ascending
+  std::vector<std::optional<double>> per_repeat;  // m/s, same order
+  std::optional<double> min, max, mean, stddev;   // over repeats that cross, m/s
+  int n_crossed = 0;                              // repeats whose curve falls below
+};
+
+// The critical velocity where the largest-piece fraction first falls below
+// `threshold` (method.md: "shattered"), for the points of one impact angle.
+// stddev is the sample standard deviation (n-1), absent for fewer than two.
+CriticalVelocity FindCriticalVelocity(const std::vector<SweepPoint>& points, double threshold);
+
+}  // namespace mill::post

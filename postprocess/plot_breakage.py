@@ -1,0 +1,260 @@
+#!/usr/bin/python3
+"""Plots of a breakage sweep from its aggregated results.
+
+Reads only summary.csv and fractions.csv (written by postprocess/breakage_results)
+and writes, per impact angle, averaged over repeats with the min/max spread:
+  pieces_vs_velocity.png      single-element and multi-element pieces vs speed
+  largest_vs_velocity.png     largest piece mass fraction vs speed, with the
+                              threshold and the critical velocity
+  mass_distribution.png       mass per size fraction at chosen speeds
+  critical_velocity.json      the speed where the largest piece fraction first
+                              falls below the threshold (linear interpolation
+                              between sweep points), of the repeat-averaged
+                              curve and per repeat (min, max, mean, std)
+
+The critical velocity follows the same rule as FindCriticalVelocity in
+postprocess/distributions.h, so the driver and this script agree.
+
+Usage: plot_breakage.py --summary S --fractions F --out DIR
+                        [--threshold 0.05] [--velocities 20,100,150]
+"""
+
+import argparse
+import csv
+import json
+import math
+import os
+import sys
+from collections import defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+SUMMARY_NEEDED = ("velocity_m_s", "angle_deg", "repeat", "n_single", "n_multi",
+                  "largest_mass_fraction")
+FRACTIONS_NEEDED = ("velocity_m_s", "angle_deg", "repeat", "fraction_index", "d_low_rel",
+                    "d_high_rel", "mass_fraction")
+
+
+def read_csv(path, needed):
+    """Reads a results CSV into a list of dicts of floats; exits naming a missing column."""
+    try:
+        with open(path, newline="") as f:
+            reader = csv.DictReader(f)
+            missing = [c for c in needed if c not in (reader.fieldnames or [])]
+            if missing:
+                sys.exit(f"{path}: missing column(s) {', '.join(missing)}")
+            rows = []
+            for line_no, row in enumerate(reader, start=2):
+                try:
+                    rows.append({k: float(row[k]) for k in needed})
+                except (TypeError, ValueError):
+                    sys.exit(f"{path}:{line_no}: expected numbers in columns {', '.join(needed)}")
+            return rows
+    except OSError as e:
+        sys.exit(f"{path}: cannot read ({e.strerror})")
+
+
+def first_crossing_below(velocities, values, threshold):
+    """Speed where values first fall below threshold, walking up in speed;
+    values at one speed are averaged first; linear interpolation between the
+    last point at/above and the first below; the first speed if it already is
+    below; None if never."""
+    by_v = defaultdict(list)
+    for v, y in zip(velocities, values):
+        by_v[v].append(y)
+    prev = None
+    for v in sorted(by_v):
+        y = sum(by_v[v]) / len(by_v[v])
+        if y < threshold:
+            if prev is None:
+                return v
+            v0, y0 = prev
+            return v0 + (threshold - y0) * (v - v0) / (y - y0)
+        prev = (v, y)
+    return None
+
+
+def critical_velocity(rows, threshold):
+    """Critical velocity of the repeat-averaged curve and its spread over repeats."""
+    vel = [r["velocity_m_s"] for r in rows]
+    val = [r["largest_mass_fraction"] for r in rows]
+    per_repeat = {}
+    for rep in sorted({int(r["repeat"]) for r in rows}):
+        sub = [r for r in rows if int(r["repeat"]) == rep]
+        per_repeat[rep] = first_crossing_below([r["velocity_m_s"] for r in sub],
+                                               [r["largest_mass_fraction"] for r in sub],
+                                               threshold)
+    crossed = [c for c in per_repeat.values() if c is not None]
+    out = {
+        "critical_velocity_m_s": first_crossing_below(vel, val, threshold),
+        "per_repeat_m_s": {str(k): v for k, v in per_repeat.items()},
+        "n_repeats": len(per_repeat),
+        "n_crossed": len(crossed),
+        "min_m_s": min(crossed) if crossed else None,
+        "max_m_s": max(crossed) if crossed else None,
+        "mean_m_s": sum(crossed) / len(crossed) if crossed else None,
+        "std_m_s": (math.sqrt(sum((c - sum(crossed) / len(crossed)) ** 2 for c in crossed)
+                              / (len(crossed) - 1)) if len(crossed) > 1 else None),
+    }
+    return out
+
+
+def stats_by_velocity(rows, key):
+    """Speeds ascending, and mean, min, max of rows[key] at each speed."""
+    by_v = defaultdict(list)
+    for r in rows:
+        by_v[r["velocity_m_s"]].append(r[key])
+    v = np.array(sorted(by_v))
+    vals = [np.array(by_v[x]) for x in v]
+    return (v, np.array([a.mean() for a in vals]), np.array([a.min() for a in vals]),
+            np.array([a.max() for a in vals]))
+
+
+def save(fig, path):
+    """Writes a figure as PNG via path.tmp and a rename, then closes it."""
+    fig.tight_layout()
+    fig.savefig(path + ".tmp", dpi=120, format="png")
+    os.replace(path + ".tmp", path)
+    plt.close(fig)
+
+
+def angle_label(angle):
+    """Legend label of an impact angle."""
+    return f"{angle:g} deg"
+
+
+def plot_pieces(by_angle, path):
+    """Single- and multi-element piece counts vs speed, mean and min/max."""
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for angle, rows in sorted(by_angle.items()):
+        for key, style, name in (("n_single", "o-", "single (fully shredded)"),
+                                 ("n_multi", "s--", "multi (partially shredded)")):
+            v, mean, lo, hi = stats_by_velocity(rows, key)
+            ax.errorbar(v, mean, yerr=[mean - lo, hi - mean], fmt=style, capsize=3,
+                        label=f"{name}, {angle_label(angle)}")
+    ax.set_xlabel("impact speed [m/s]")
+    ax.set_ylabel("number of pieces")
+    ax.set_title("Pieces per impact (mean, min-max over repeats)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    save(fig, path)
+
+
+def plot_largest(by_angle, critical, threshold, path):
+    """Largest piece mass fraction vs speed with the threshold and critical speed."""
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for angle, rows in sorted(by_angle.items()):
+        v, mean, lo, hi = stats_by_velocity(rows, "largest_mass_fraction")
+        line, = ax.plot(v, mean, "o-", label=f"mean, {angle_label(angle)}")
+        ax.fill_between(v, lo, hi, color=line.get_color(), alpha=0.2)
+        c = critical[angle]
+        if c["critical_velocity_m_s"] is not None:
+            ax.axvline(c["critical_velocity_m_s"], color=line.get_color(), ls=":",
+                       label=f"critical {c['critical_velocity_m_s']:.1f} m/s")
+            if c["min_m_s"] is not None and c["max_m_s"] > c["min_m_s"]:
+                ax.axvspan(c["min_m_s"], c["max_m_s"], color=line.get_color(), alpha=0.08)
+    ax.axhline(threshold, color="k", ls="--", lw=0.8, label=f"threshold {threshold:g}")
+    ax.set_xlabel("impact speed [m/s]")
+    ax.set_ylabel("largest piece / lump mass [-]")
+    ax.set_ylim(0, 1.05)
+    ax.set_title("Largest piece (band: min-max over repeats)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    save(fig, path)
+
+
+def plot_distribution(fractions, velocities, path):
+    """Mass per size fraction at chosen speeds (nearest in the sweep), mean and min/max."""
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    available = sorted({r["velocity_m_s"] for r in fractions})
+    if velocities:
+        chosen = sorted({min(available, key=lambda a: abs(a - w)) for w in velocities})
+    else:
+        chosen = available
+    angles = sorted({r["angle_deg"] for r in fractions})
+    edges = {}
+    for r in fractions:
+        edges[int(r["fraction_index"])] = (r["d_low_rel"], r["d_high_rel"])
+    n = max(edges) + 1 if edges else 0
+    series = [(a, v) for a in angles for v in chosen]
+    width = 0.8 / max(1, len(series))
+    x = np.arange(n)
+    for s, (angle, vel) in enumerate(series):
+        per_repeat = defaultdict(lambda: np.zeros(n))
+        for r in fractions:
+            if r["angle_deg"] == angle and r["velocity_m_s"] == vel:
+                per_repeat[int(r["repeat"])][int(r["fraction_index"])] = r["mass_fraction"]
+        if not per_repeat:
+            continue
+        data = np.array(list(per_repeat.values()))
+        mean, lo, hi = data.mean(axis=0), data.min(axis=0), data.max(axis=0)
+        label = f"{vel:g} m/s" + (f", {angle_label(angle)}" if len(angles) > 1 else "")
+        ax.bar(x + (s - (len(series) - 1) / 2) * width, mean, width,
+               yerr=[mean - lo, hi - mean], capsize=2, label=label)
+    ax.set_xticks(x)
+    ax.set_xticklabels([f"{edges[k][0]:g}-{edges[k][1]:g}" for k in range(n)], rotation=45,
+                       ha="right", fontsize=8)
+    ax.set_xlabel("size fraction d/D [-]")
+    ax.set_ylabel("mass fraction [-]")
+    ax.set_title("Mass distribution over size fractions (mean, min-max over repeats)")
+    ax.grid(True, axis="y", alpha=0.3)
+    ax.legend(fontsize=8)
+    save(fig, path)
+
+
+def parse_velocities(text):
+    """Comma-separated speeds, or an empty list."""
+    if not text:
+        return []
+    try:
+        return [float(t) for t in text.split(",") if t.strip()]
+    except ValueError:
+        sys.exit(f"--velocities: expected comma-separated speeds in m/s, got '{text}'")
+
+
+def main(argv=None):
+    """Reads the CSVs, writes the PNGs and critical_velocity.json into --out."""
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--summary", required=True, help="summary.csv")
+    p.add_argument("--fractions", required=True, help="fractions.csv")
+    p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--threshold", type=float, default=0.05,
+                   help="largest piece fraction below which the lump counts as shattered")
+    p.add_argument("--velocities", default="", help="speeds for the distribution plot, m/s")
+    a = p.parse_args(argv)
+    if not 0.0 < a.threshold < 1.0:
+        sys.exit(f"--threshold: expected a fraction in (0, 1), got {a.threshold}")
+
+    summary = read_csv(a.summary, SUMMARY_NEEDED)
+    fractions = read_csv(a.fractions, FRACTIONS_NEEDED)
+    if not summary:
+        sys.exit(f"{a.summary}: no rows")
+    os.makedirs(a.out, exist_ok=True)
+
+    by_angle = defaultdict(list)
+    for r in summary:
+        by_angle[r["angle_deg"]].append(r)
+    critical = {angle: critical_velocity(rows, a.threshold) for angle, rows in by_angle.items()}
+
+    plot_pieces(by_angle, os.path.join(a.out, "pieces_vs_velocity.png"))
+    plot_largest(by_angle, critical, a.threshold, os.path.join(a.out, "largest_vs_velocity.png"))
+    plot_distribution(fractions, parse_velocities(a.velocities),
+                      os.path.join(a.out, "mass_distribution.png"))
+
+    out = {"threshold": a.threshold,
+           "quantity": "largest_mass_fraction",
+           "angles": {f"{angle:g}": c for angle, c in sorted(critical.items())}}
+    path = os.path.join(a.out, "critical_velocity.json")
+    with open(path + ".tmp", "w") as f:
+        json.dump(out, f, indent=2)
+        f.write("\n")
+    os.replace(path + ".tmp", path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

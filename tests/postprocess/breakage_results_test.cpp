@@ -1,0 +1,231 @@
+// summary.csv, fractions.csv and breakage.h5: layout, round trips, atomic writes.
+#include "postprocess/breakage_results.h"
+
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+
+namespace mill::post {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kRho = 2580.0;
+
+// A fresh empty directory for one test.
+fs::path TestDir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const fs::path dir = fs::temp_directory_path() /
+                       (std::string("mill_post_") + info->test_suite_name() + "_" + info->name());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// First line of a text file.
+std::string FirstLine(const fs::path& p) {
+  std::ifstream in(p);
+  std::string line;
+  std::getline(in, line);
+  return line;
+}
+
+// Number of lines of a text file.
+int CountLines(const fs::path& p) {
+  std::ifstream in(p);
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) ++n;
+  return n;
+}
+
+// An impact of n elements (radius 1.2 mm) where elements 1..k are one bonded
+// chain and the rest are singles; D = 20 mm.
+ImpactResult MakeImpact(double v, int repeat, int n = 10, int k = 4) {
+  std::vector<Element> e;
+  for (int i = 1; i <= n; ++i) {
+    Element x;
+    x.id = i;
+    x.radius = 1.2e-3;
+    x.mass = SphereMass(x.radius, kRho);
+    x.v = {0.0, 0.0, v * 0.1};
+    e.push_back(x);
+  }
+  std::vector<Bond> b;
+  for (int i = 1; i < k; ++i) b.push_back({i, i + 1});
+  ImpactSpec spec;
+  spec.conditions = {v, 90.0, repeat};
+  spec.initial_bonds = 20;
+  spec.lump_diameter_m = 0.02;
+  spec.density_kg_m3 = kRho;
+  spec.wall_seconds = 12.5;
+  return AnalyseImpact(e, b, spec);
+}
+
+TEST(SummaryCsv, HeaderStartsWithTheRequiredColumnsInOrder) {
+  const auto dir = TestDir();
+  AppendSummaryCsv((dir / "summary.csv").string(), MakeImpact(150.0, 0).summary);
+  const std::string required =
+      "velocity_m_s,angle_deg,repeat,n_elements,n_pieces,n_single,n_multi,largest_mass_fraction,"
+      "single_mass_fraction,broken_bond_fraction,specific_energy_J_kg,t10_percent,wall_seconds";
+  const std::string header = FirstLine(dir / "summary.csv");
+  EXPECT_EQ(header.substr(0, required.size()), required);
+  EXPECT_EQ(header.substr(required.size(), 23), ",specific_energy_kWh_t,");
+}
+
+TEST(SummaryCsv, AppendsRowsUnderOneHeaderAndReadsBack) {
+  const auto dir = TestDir();
+  const std::string path = (dir / "summary.csv").string();
+  const auto a = MakeImpact(60.0, 0);
+  const auto b = MakeImpact(150.0, 1, 12, 2);
+  AppendSummaryCsv(path, a.summary);
+  AppendSummaryCsv(path, b.summary);
+  EXPECT_EQ(CountLines(path), 3);
+  EXPECT_FALSE(fs::exists(path + ".tmp"));
+  const auto rows = ReadSummaryCsv(path);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_DOUBLE_EQ(rows[0].velocity_m_s, 60.0);
+  EXPECT_DOUBLE_EQ(rows[0].specific_energy_J_kg, 1800.0);
+  EXPECT_DOUBLE_EQ(rows[0].specific_energy_kWh_t, 0.5);
+  EXPECT_EQ(rows[0].n_pieces, 7);
+  EXPECT_EQ(rows[0].n_single, 6);
+  EXPECT_EQ(rows[0].n_multi, 1);
+  EXPECT_EQ(rows[1].repeat, 1);
+  EXPECT_EQ(rows[1].n_elements, 12);
+  EXPECT_DOUBLE_EQ(rows[1].largest_mass_fraction, b.summary.largest_mass_fraction);
+  EXPECT_DOUBLE_EQ(rows[1].t10_percent, b.summary.t10_percent);
+  EXPECT_DOUBLE_EQ(rows[1].wall_seconds, 12.5);
+  EXPECT_EQ(rows[1].t10_resolved, b.summary.t10_resolved);
+}
+
+TEST(SummaryCsv, ForeignHeaderIsRefused) {
+  const auto dir = TestDir();
+  const std::string path = (dir / "summary.csv").string();
+  std::ofstream(path) << "a,b,c\n1,2,3\n";
+  EXPECT_THROW(AppendSummaryCsv(path, MakeImpact(60.0, 0).summary), PostError);
+}
+
+TEST(SummaryCsv, MissingRequiredColumnIsNamed) {
+  const auto dir = TestDir();
+  const std::string path = (dir / "summary.csv").string();
+  std::ofstream(path) << "velocity_m_s,angle_deg\n1,2\n";
+  try {
+    ReadSummaryCsv(path);
+    FAIL() << "expected PostError";
+  } catch (const PostError& e) {
+    EXPECT_NE(std::string(e.what()).find("'repeat'"), std::string::npos) << e.what();
+  }
+}
+
+TEST(FractionsCsv, OneRowPerFractionSummingToOne) {
+  const auto dir = TestDir();
+  const std::string path = (dir / "fractions.csv").string();
+  const auto r = MakeImpact(60.0, 0);
+  AppendFractionsCsv(path, r);
+  EXPECT_EQ(FirstLine(path),
+            "velocity_m_s,angle_deg,repeat,fraction_index,d_low_rel,d_high_rel,mass_fraction");
+  EXPECT_EQ(CountLines(path), 13);
+  EXPECT_NEAR(std::accumulate(r.fraction_mass.begin(), r.fraction_mass.end(), 0.0), 1.0, 1e-14);
+}
+
+TEST(Impact, T10FlagWhenElementsAreCoarserThanTenthOfD) {
+  // Ten equal elements: the lump's solid is 10 element volumes, so one element
+  // has d/D_solid = 10^(-1/3) = 0.464, coarser than D/10.
+  const auto r = MakeImpact(60.0, 0);
+  EXPECT_FALSE(r.summary.t10_resolved);
+  EXPECT_NEAR(r.summary.element_d_rel_max, std::cbrt(0.1), 1e-12);
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("t10"), std::string::npos);
+}
+
+TEST(Impact, GroupName) {
+  EXPECT_EQ(ImpactGroupName({150.0, 90.0, 0}), "v150.0_a90_r0");
+  EXPECT_EQ(ImpactGroupName({4.25, 45.0, 3}), "v4.25_a45_r3");
+}
+
+// Reads a string attribute of an object.
+std::string ReadStringAttr(hid_t obj, const char* name) {
+  const hid_t attr = H5Aopen(obj, name, H5P_DEFAULT);
+  const hid_t type = H5Aget_type(attr);
+  std::string s(H5Tget_size(type), '\0');
+  H5Aread(attr, type, s.data());
+  H5Tclose(type);
+  H5Aclose(attr);
+  return s.c_str();
+}
+
+TEST(BreakageH5, MassDatasetAndUnitRoundTrip) {
+  const auto dir = TestDir();
+  const std::string path = (dir / "breakage.h5").string();
+  const auto r = MakeImpact(150.0, 0);
+  WriteBreakageH5(path, {r, MakeImpact(20.0, 1)});
+  EXPECT_FALSE(fs::exists(path + ".tmp"));
+
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  const hid_t set = H5Dopen2(file, "/impacts/v150.0_a90_r0/mass", H5P_DEFAULT);
+  ASSERT_GE(set, 0);
+  std::vector<double> mass(r.fragments.size());
+  ASSERT_GE(H5Dread(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, mass.data()), 0);
+  for (std::size_t k = 0; k < mass.size(); ++k) EXPECT_DOUBLE_EQ(mass[k], r.fragments[k].mass);
+  EXPECT_EQ(ReadStringAttr(set, "unit"), "kg");
+  H5Dclose(set);
+
+  const hid_t vel = H5Dopen2(file, "/impacts/v150.0_a90_r0/velocity", H5P_DEFAULT);
+  const hid_t space = H5Dget_space(vel);
+  hsize_t dims[2] = {0, 0};
+  EXPECT_EQ(H5Sget_simple_extent_ndims(space), 2);
+  H5Sget_simple_extent_dims(space, dims, nullptr);
+  EXPECT_EQ(dims[0], r.fragments.size());
+  EXPECT_EQ(dims[1], 3u);
+  EXPECT_EQ(ReadStringAttr(vel, "unit"), "m/s");
+  H5Sclose(space);
+  H5Dclose(vel);
+
+  const hid_t sv = H5Dopen2(file, "/summary/velocity_m_s", H5P_DEFAULT);
+  double v[2] = {0, 0};
+  H5Dread(sv, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v);
+  EXPECT_DOUBLE_EQ(v[0], 150.0);
+  EXPECT_DOUBLE_EQ(v[1], 20.0);
+  EXPECT_EQ(ReadStringAttr(sv, "unit"), "m/s");
+  H5Dclose(sv);
+  H5Fclose(file);
+}
+
+TEST(BreakageH5, DuplicateImpactIsRefusedAndLeavesNoFile) {
+  const auto dir = TestDir();
+  const std::string path = (dir / "breakage.h5").string();
+  EXPECT_THROW(WriteBreakageH5(path, {MakeImpact(150.0, 0), MakeImpact(150.0, 0)}), PostError);
+  EXPECT_FALSE(fs::exists(path));
+}
+
+TEST(BreakageH5, MergeOfPerImpactFiles) {
+  const auto dir = TestDir();
+  const std::string a = (dir / "a.h5").string(), b = (dir / "b.h5").string();
+  const std::string merged = (dir / "breakage.h5").string();
+  WriteBreakageH5(a, {MakeImpact(150.0, 0)});
+  WriteBreakageH5(b, {MakeImpact(20.0, 0, 10, 9)});
+  MergeBreakageH5Files(merged, {a, b});
+
+  const hid_t file = H5Fopen(merged.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  EXPECT_GT(H5Lexists(file, "/impacts/v150.0_a90_r0", H5P_DEFAULT), 0);
+  EXPECT_GT(H5Lexists(file, "/impacts/v20.0_a90_r0", H5P_DEFAULT), 0);
+  const hid_t set = H5Dopen2(file, "/summary/n_pieces", H5P_DEFAULT);
+  long long n[2] = {0, 0};
+  H5Dread(set, H5T_NATIVE_LLONG, H5S_ALL, H5S_ALL, H5P_DEFAULT, n);
+  EXPECT_EQ(n[0], 7);
+  EXPECT_EQ(n[1], 2);
+  EXPECT_EQ(ReadStringAttr(set, "unit"), "1");
+  H5Dclose(set);
+  H5Fclose(file);
+
+  EXPECT_THROW(MergeBreakageH5Files((dir / "twice.h5").string(), {a, a}), PostError);
+  EXPECT_FALSE(fs::exists(dir / "twice.h5"));
+}
+
+}  // namespace
+}  // namespace mill::post

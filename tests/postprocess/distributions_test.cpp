@@ -1,0 +1,95 @@
+// Size fractions, t10 and the critical velocity on hand-made data.
+#include "postprocess/distributions.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+
+#include "postprocess/fragments.h"
+
+namespace mill::post {
+namespace {
+
+TEST(Distributions, DefaultEdgesGiveTwelveFractions) {
+  const auto e = DefaultFractionEdges();
+  EXPECT_EQ(e.size(), 13u);
+  EXPECT_NO_THROW(ValidateFractionEdges(e));
+}
+
+TEST(Distributions, BadEdgesAreRejectedWithTheIndex) {
+  try {
+    ValidateFractionEdges({0.0, 0.2, 0.1});
+    FAIL() << "expected PostError";
+  } catch (const PostError& e) {
+    EXPECT_NE(std::string(e.what()).find("size_fraction_edges[2]"), std::string::npos);
+  }
+}
+
+TEST(Distributions, FractionsSumToOneAndBinsAreHalfOpen) {
+  const std::vector<double> edges = {0.0, 0.1, 0.5, 1.0};
+  // 0.1 sits on an edge (goes up), 1.0 is the top edge and 1.3 above it (top).
+  const std::vector<double> d = {0.05, 0.1, 0.7, 1.0, 1.3};
+  const std::vector<double> m = {1.0, 2.0, 3.0, 4.0, 10.0};
+  const auto f = SizeFractionMass(d, m, edges);
+  ASSERT_EQ(f.size(), 3u);
+  EXPECT_DOUBLE_EQ(f[0], 1.0 / 20.0);
+  EXPECT_DOUBLE_EQ(f[1], 2.0 / 20.0);
+  EXPECT_DOUBLE_EQ(f[2], 17.0 / 20.0);
+  EXPECT_NEAR(std::accumulate(f.begin(), f.end(), 0.0), 1.0, 1e-15);
+}
+
+TEST(Distributions, DefaultFractionsSumToOne) {
+  const std::vector<double> d = {0.01, 0.06, 0.08, 0.12, 0.33, 0.45, 0.66, 0.8, 0.9, 0.99};
+  const std::vector<double> m = {0.3, 1.1, 0.7, 2.0, 5.0, 0.1, 0.2, 3.3, 9.0, 0.01};
+  const auto f = SizeFractionMass(d, m, DefaultFractionEdges());
+  EXPECT_EQ(f.size(), 12u);
+  EXPECT_NEAR(std::accumulate(f.begin(), f.end(), 0.0), 1.0, 1e-14);
+}
+
+TEST(Distributions, T10OnHandMadePieces) {
+  // Finer than 0.1: 1 + 2 of 10 mass units; the piece at exactly 0.1 is not finer.
+  EXPECT_DOUBLE_EQ(T10Percent({0.05, 0.09, 0.1, 0.5}, {1.0, 2.0, 3.0, 4.0}), 30.0);
+  EXPECT_DOUBLE_EQ(T10Percent({0.5}, {1.0}), 0.0);
+}
+
+TEST(CriticalVelocity, InterpolatesTheFirstCrossing) {
+  const auto v = FirstCrossingBelow({10, 20, 40, 80}, {1.0, 0.6, 0.2, 0.01}, 0.05);
+  ASSERT_TRUE(v.has_value());
+  EXPECT_NEAR(*v, 40.0 + 0.15 * 40.0 / 0.19, 1e-12);
+}
+
+TEST(CriticalVelocity, OrderOfPointsDoesNotMatter) {
+  const auto v = FirstCrossingBelow({80, 10, 40, 20}, {0.01, 1.0, 0.2, 0.6}, 0.05);
+  ASSERT_TRUE(v.has_value());
+  EXPECT_NEAR(*v, 40.0 + 0.15 * 40.0 / 0.19, 1e-12);
+}
+
+TEST(CriticalVelocity, FirstFallIsUsedNotALaterOne) {
+  // Falls below at 30, recovers at 40 (noise), falls again: the first counts.
+  const auto v = FirstCrossingBelow({10, 30, 40, 50}, {0.5, 0.0, 0.5, 0.0}, 0.1);
+  EXPECT_NEAR(*v, 10.0 + 0.4 * 20.0 / 0.5, 1e-12);
+}
+
+TEST(CriticalVelocity, NeverBelowAndAlreadyBelow) {
+  EXPECT_FALSE(FirstCrossingBelow({10, 20}, {1.0, 0.9}, 0.05).has_value());
+  EXPECT_DOUBLE_EQ(*FirstCrossingBelow({10, 20}, {0.01, 0.0}, 0.05), 10.0);
+  EXPECT_FALSE(FirstCrossingBelow({}, {}, 0.05).has_value());
+}
+
+TEST(CriticalVelocity, SpreadOverRepeats) {
+  const std::vector<SweepPoint> pts = {{10, 0, 1.0}, {20, 0, 0.5}, {30, 0, 0.0},
+                                       {10, 1, 1.0}, {20, 1, 0.3}, {30, 1, 0.02}};
+  const auto c = FindCriticalVelocity(pts, 0.1);
+  ASSERT_EQ(c.per_repeat.size(), 2u);
+  EXPECT_NEAR(*c.per_repeat[0], 28.0, 1e-12);
+  EXPECT_NEAR(*c.per_repeat[1], 20.0 + 2.0 / 0.28, 1e-12);
+  EXPECT_NEAR(*c.of_mean_curve, 20.0 + 3.0 / 0.39, 1e-12);
+  EXPECT_EQ(c.n_crossed, 2);
+  EXPECT_NEAR(*c.min, 20.0 + 2.0 / 0.28, 1e-12);
+  EXPECT_NEAR(*c.max, 28.0, 1e-12);
+  EXPECT_NEAR(*c.stddev, (28.0 - (20.0 + 2.0 / 0.28)) / std::sqrt(2.0), 1e-12);
+}
+
+}  // namespace
+}  // namespace mill::post
