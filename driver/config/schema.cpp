@@ -110,7 +110,7 @@ Schema make_case_schema() {
       range(key("lump.radius_spread", T::Real, "", "0.25", "Element radii uniform in (1 +- spread) x mean"), 0, false, 1, true),
       at_least(key("lump.n_packings", T::Int, "", "1", "Distinct random packings (lumps) for statistics"), 1),
       at_least(key("lump.seed", T::Int, "", "1001", "Seed of the first packing"), 1),
-      at_least(key("lump.bond_gap", T::Real, "", "0.1", "Bond pairs whose gap is below this x mean radius"), 0),
+      at_least(key("lump.bond_gap", T::Real, "", "0.2", "Bond pairs whose gap is below this x min(Ri, Rj) (0.2: coordination ~6)"), 0),
       at_least(key("lump.max_bonds", T::Int, "", "16", "Cap of bonds per element"), 1),
       positive(key("lump.bond_radius_multiplier", T::Real, "", "1.0", "Bond disc radius = multiplier x min(Ri, Rj)")),
 

@@ -1,21 +1,119 @@
-// Stage 'breakage': one bonded-lump impact per condition (issue 4).
+// Stage 'breakage': bonded-lump impacts and their fragment statistics.
 #include "stages/breakage_stage.h"
 
 #include <fmt/format.h>
+#include <vtkCellArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkIntArray.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkXMLPolyDataWriter.h>
 
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <random>
+#include <unordered_map>
+
+#include "engine/liggghts.h"
+#include "jobs/job_store.h"
+#include "postprocess/breakage_results.h"
+#include "postprocess/distributions.h"
+#include "postprocess/lammps_dump.h"
+#include "progress.h"
+#include "stages/lump_builder.h"
+#include "stages/material.h"
 #include "stages/stage_util.h"
 
 namespace mill {
+namespace fs = std::filesystem;
+using engine::num;
+
+namespace {
+
+nlohmann::json bond_json(const BondParams& b) {
+  return {{"modulus", b.modulus},   {"stiffness_ratio", b.stiffness_ratio},       {"tensile", b.tensile},
+          {"cohesion", b.cohesion}, {"friction_angle_deg", b.friction_angle_deg}, {"radius_multiplier", b.radius_multiplier}};
+}
+
+// A uniformly random rotation (Shoemake 1992, "Uniform random rotations",
+// Graphics Gems III) as axis and angle in degrees, from a seed.
+std::array<double, 4> random_rotation(unsigned long long seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double u1 = u(rng), u2 = u(rng), u3 = u(rng);
+  const double a = std::sqrt(1 - u1), b = std::sqrt(u1);
+  const double q[4] = {b * std::cos(2 * M_PI * u3), a * std::sin(2 * M_PI * u2), a * std::cos(2 * M_PI * u2),
+                       b * std::sin(2 * M_PI * u3)};  // w, x, y, z
+  const double w = std::min(1.0, std::abs(q[0]));
+  const double s = q[0] < 0 ? -1.0 : 1.0;
+  const double angle = 2 * std::acos(w) * 180.0 / M_PI;
+  const double n = std::sqrt(q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (n < 1e-12) return {0, 0, 1, 0};
+  return {s * q[1] / n, s * q[2] / n, s * q[3] / n, angle};
+}
+
+// Elements as points for ParaView, coloured by fragment (0 = largest piece).
+void write_fragments_vtp(const fs::path& file, const post::DumpSnapshot& snap, const post::ImpactResult& r) {
+  std::unordered_map<long long, int> frag_of;
+  for (size_t f = 0; f < r.fragments.size(); ++f)
+    for (long long id : r.fragments[f].ids) frag_of[id] = static_cast<int>(f);
+  vtkNew<vtkPoints> pts;
+  vtkNew<vtkIntArray> frag, size, ids;
+  vtkNew<vtkDoubleArray> radius, vel;
+  frag->SetName("fragment");
+  size->SetName("fragment_elements");
+  ids->SetName("id");
+  radius->SetName("radius");
+  vel->SetName("velocity");
+  vel->SetNumberOfComponents(3);
+  vtkNew<vtkCellArray> verts;
+  for (const auto& e : snap.elements) {
+    const vtkIdType pid = pts->InsertNextPoint(e.x[0], e.x[1], e.x[2]);
+    verts->InsertNextCell(1, &pid);
+    const int f = frag_of.count(e.id) ? frag_of[e.id] : -1;
+    frag->InsertNextValue(f);
+    size->InsertNextValue(f >= 0 ? static_cast<int>(r.fragments[f].n_elements()) : 0);
+    ids->InsertNextValue(static_cast<int>(e.id));
+    radius->InsertNextValue(e.radius);
+    vel->InsertNextTuple3(e.v[0], e.v[1], e.v[2]);
+  }
+  vtkNew<vtkPolyData> pd;
+  pd->SetPoints(pts);
+  pd->SetVerts(verts);
+  for (vtkDataArray* a : std::initializer_list<vtkDataArray*>{frag, size, ids, radius, vel}) pd->GetPointData()->AddArray(a);
+  pd->GetPointData()->SetActiveScalars("fragment");
+  const fs::path tmp = file.string() + ".tmp.vtp";
+  vtkNew<vtkXMLPolyDataWriter> w;
+  w->SetFileName(tmp.c_str());
+  w->SetInputData(pd);
+  w->SetDataModeToBinary();
+  if (w->Write() != 1) throw std::runtime_error("cannot write " + tmp.string());
+  fs::rename(tmp, file);
+}
+
+long read_long(const fs::path& f) {
+  std::ifstream in(f);
+  double v = -1;
+  if (!(in >> v)) throw std::runtime_error(f.string() + ": no number (the deck did not reach its first run)");
+  return std::lround(v);
+}
+
+}  // namespace
 
 Plan BreakageStage::plan(const StageContext& ctx) const {
   Plan p;
   const auto& d = ctx.cfg.doc;
   if (d.str("breakage.conditions") == "transport") {
-    p.note = "impact conditions come from transport/ (binned flywheel impacts); they are known after that stage";
+    p.note = "impact conditions come from transport/ (binned flywheel impacts); not implemented yet (issue 8)";
     return p;
   }
-  nlohmann::json base = case_keys(d, {"lump.", "breakage.duration_after_contact", "breakage.timestep", "breakage.dump_interval"});
+  nlohmann::json base = case_keys(d, {"lump.", "breakage.duration_after_contact", "breakage.timestep"});
   base["ore"] = ore_keys(ctx.cfg.ore);
+  base["bond"] = bond_json(bond_params_for(ctx.cfg, ctx.run_dir));
+  base["deck_version"] = 1;
   for (double v : d.reals("breakage.velocities"))
     for (double a : d.reals("breakage.angles"))
       for (long r = 0; r < d.integer("breakage.repeats"); ++r) {
@@ -30,8 +128,177 @@ Plan BreakageStage::plan(const StageContext& ctx) const {
   return p;
 }
 
-void BreakageStage::run_job(StageContext&, const JobSpec&, const std::filesystem::path&) {
-  throw NotImplemented("stage 'breakage' is not implemented yet (issue 4: bonded lump impacts)");
+std::string run_impact(StageContext& ctx, double velocity, double angle, int repeat, const fs::path& out_dir,
+                       const std::string& label) {
+  const auto& d = ctx.cfg.doc;
+  const LumpSpec spec = lump_spec(ctx.cfg);
+  const int packing = static_cast<int>(repeat % d.integer("lump.n_packings"));
+  const LumpInfo lump = ensure_lump(ctx, spec, packing, label);
+  const BondParams bond = bond_params_for(ctx.cfg, ctx.run_dir);
+
+  // Start just short of contact: a gap of a tenth of an element radius.
+  const double gap = 0.1 * lump.mean_radius;
+  const double t_contact = gap / (velocity * std::sin(angle * M_PI / 180.0));
+  const double t_end = t_contact + d.real("breakage.duration_after_contact");
+  const auto rot = random_rotation(1469598103ULL * static_cast<unsigned long long>(d.integer("lump.seed")) + 7919ULL * repeat);
+
+  const fs::path work = out_dir / "run";
+  fs::remove_all(work);
+  engine::DeckRun run;
+  run.deck = ctx.cfg.project_dir / "liggghts_inputs" / "impact.in.tmpl";
+  run.workdir = work;
+  run.np = ctx.opts.np;
+  run.job = "breakage/" + label;
+  run.vars = {{"lump_file", fs::absolute(lump.data).string()},
+              {"velocity", num(velocity)},
+              {"angle", num(angle)},
+              {"z_plane", num(-(lump.outer_radius + gap))},
+              {"rot_x", num(rot[0])},
+              {"rot_y", num(rot[1])},
+              {"rot_z", num(rot[2])},
+              {"rot_angle", num(rot[3])},
+              {"t_end", num(t_end)},
+              {"dt", num(d.real("breakage.timestep"))},
+              {"skin", num(0.3 * lump.mean_radius)},
+              {"dump_interval", num(d.real("breakage.dump_interval"))},
+              {"bond_gap", num(d.real("lump.bond_gap"))},
+              {"max_bonds", std::to_string(d.integer("lump.max_bonds"))}};
+  for (const auto& kv : material_vars(ctx.cfg.ore, bond)) run.vars.push_back(kv);
+  const engine::Result res = engine::run_deck(ctx.runner, run, ctx.progress, label);
+
+  // Fragment analysis of the final state.
+  post::ImpactSpec is;
+  is.conditions = {velocity, angle, repeat};
+  is.initial_bonds = read_long(work / "bonds_initial.txt");
+  is.lump_diameter_m = 2 * lump.outer_radius;
+  is.density_kg_m3 = ctx.cfg.ore.real("density");
+  is.fraction_edges = d.reals("breakage.size_fraction_edges");
+  is.wall_seconds = res.seconds;
+  if (is.initial_bonds != lump.bonds)
+    ctx.progress.warn(fmt::format("{}: {} bonds at impact but {} when the lump was built (same rule): check lump.bond_gap",
+                                  label, is.initial_bonds, lump.bonds));
+  const post::DumpSnapshot snap = post::ReadDumpLastSnapshot((work / "final.dump").string(), is.density_kg_m3);
+  if (static_cast<long>(snap.elements.size()) != lump.elements)
+    throw std::runtime_error(fmt::format("{}: {} elements in the final state, {} in the lump: elements were lost", label,
+                                         snap.elements.size(), lump.elements));
+  const auto bonds = post::ReadIntactBonds((work / "bonds_final.txt").string());
+  const post::ImpactResult r = post::AnalyseImpact(snap.elements, bonds, is, (work / "bonds_final.txt").string());
+  for (const auto& w : r.warnings) ctx.progress.warn(label + ": " + w);
+
+  // Outputs, each complete or absent (temporary name, then rename).
+  for (const char* f : {"summary.csv", "fractions.csv"}) fs::remove(out_dir / f);
+  const fs::path stmp = out_dir / "summary.csv.part", ftmp = out_dir / "fractions.csv.part";
+  fs::remove(stmp);
+  fs::remove(ftmp);
+  post::AppendSummaryCsv(stmp.string(), r.summary);
+  post::AppendFractionsCsv(ftmp.string(), r);
+  post::WriteBreakageH5((out_dir / "impact.h5").string(), {r});
+  write_fragments_vtp(out_dir / "fragments.vtp", snap, r);
+  const auto& s = r.summary;
+  nlohmann::json j = {{"velocity_m_s", velocity},
+                      {"angle_deg", angle},
+                      {"repeat", repeat},
+                      {"lump", {{"label", lump.label},
+                                {"elements", lump.elements},
+                                {"outer_diameter_m", 2 * lump.outer_radius},
+                                {"mean_element_radius_m", lump.mean_radius},
+                                {"coordination", lump.coordination}}},
+                      {"bond_parameters", bond_json(bond)},
+                      {"bond_parameters_origin", bond.origin},
+                      {"n_pieces", s.n_pieces},
+                      {"n_single", s.n_single},
+                      {"n_multi", s.n_multi},
+                      {"largest_mass_fraction", s.largest_mass_fraction},
+                      {"single_mass_fraction", s.single_mass_fraction},
+                      {"broken_bond_fraction", s.broken_bond_fraction},
+                      {"specific_energy_J_kg", s.specific_energy_J_kg},
+                      {"specific_energy_kWh_t", s.specific_energy_kWh_t},
+                      {"t10_percent", s.t10_percent},
+                      {"t10_resolved", s.t10_resolved},
+                      {"warnings", r.warnings},
+                      {"wall_seconds", res.seconds}};
+  jobs::atomic_write(out_dir / "result.json", j.dump(2) + "\n");
+  fs::rename(stmp, out_dir / "summary.csv");
+  fs::rename(ftmp, out_dir / "fractions.csv");
+  // The raw run stays for inspection (dumps for ParaView, logs); it is small
+  // next to the VTK dumps a user asks for.
+  return fmt::format(
+      "{:g} m/s at {:g} deg: {} pieces ({} single, {} multi), largest {:.1f}%, single-element mass {:.1f}%, "
+      "broken bonds {:.1f}%, {:.3g} kWh/t, t10 {:.1f}%{} [{:.1f} s]",
+      velocity, angle, s.n_pieces, s.n_single, s.n_multi, 100 * s.largest_mass_fraction, 100 * s.single_mass_fraction,
+      100 * s.broken_bond_fraction, s.specific_energy_kWh_t, s.t10_percent, s.t10_resolved ? "" : " (unresolved)",
+      res.seconds);
+}
+
+void BreakageStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& job_dir) {
+  const std::string line = run_impact(ctx, job.inputs.at("velocity").get<double>(), job.inputs.at("angle").get<double>(),
+                                      job.inputs.at("repeat").get<int>(), job_dir, job.label);
+  ctx.progress.info("[breakage] " + job.label + ": " + line);
+}
+
+void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) {
+  if (jobs.empty()) return;
+  const fs::path dir = ctx.stage_dir;
+  const jobs::JobStore store(dir);
+  std::vector<std::string> h5;
+  std::vector<post::ImpactSummary> rows;
+  std::string fractions_text;
+  for (const auto& j : jobs) {
+    const fs::path jd = store.job_dir(j.label);
+    h5.push_back((jd / "impact.h5").string());
+    for (const auto& s : post::ReadSummaryCsv((jd / "summary.csv").string())) rows.push_back(s);
+    std::ifstream in(jd / "fractions.csv");
+    std::string line;
+    bool header = true;
+    while (std::getline(in, line)) {
+      if (header) {
+        if (fractions_text.empty()) fractions_text = line + "\n";
+        header = false;
+        continue;
+      }
+      fractions_text += line + "\n";
+    }
+  }
+  const fs::path stmp = dir / "summary.csv.part";
+  fs::remove(stmp);
+  for (const auto& s : rows) post::AppendSummaryCsv(stmp.string(), s);
+  fs::rename(stmp, dir / "summary.csv");
+  jobs::atomic_write(dir / "fractions.csv", fractions_text);
+  post::MergeBreakageH5Files((dir / "breakage.h5").string(), h5);
+
+  // Critical velocity per angle: largest piece falls below the threshold.
+  const double thr = ctx.cfg.doc.real("breakage.critical_largest_fraction");
+  nlohmann::json crit = nlohmann::json::array();
+  std::map<double, std::vector<post::SweepPoint>> by_angle;
+  for (const auto& s : rows) by_angle[s.angle_deg].push_back({s.velocity_m_s, s.repeat, s.largest_mass_fraction});
+  for (const auto& [angle, pts] : by_angle) {
+    const auto c = post::FindCriticalVelocity(pts, thr);
+    nlohmann::json e = {{"angle_deg", angle}, {"threshold", thr}, {"repeats_crossing", c.n_crossed}};
+    e["critical_velocity_m_s"] = c.of_mean_curve ? nlohmann::json(*c.of_mean_curve) : nlohmann::json(nullptr);
+    e["min_m_s"] = c.min ? nlohmann::json(*c.min) : nlohmann::json(nullptr);
+    e["max_m_s"] = c.max ? nlohmann::json(*c.max) : nlohmann::json(nullptr);
+    crit.push_back(e);
+    ctx.progress.info(c.of_mean_curve
+                          ? fmt::format("[breakage] critical velocity at {:g} deg (largest piece < {:g}%): {:.1f} m/s{}",
+                                        angle, 100 * thr, *c.of_mean_curve,
+                                        c.min && c.max && *c.min != *c.max
+                                            ? fmt::format(" (repeats {:.1f}-{:.1f} m/s)", *c.min, *c.max)
+                                            : "")
+                          : fmt::format("[breakage] at {:g} deg the largest piece never fell below {:g}% in the sweep",
+                                        angle, 100 * thr));
+  }
+  jobs::atomic_write(dir / "critical_velocity.json", crit.dump(2) + "\n");
+
+  // Plots from the merged CSVs (matplotlib, Debian's python3).
+  engine::Command c;
+  c.argv = {"/usr/bin/python3", (ctx.cfg.project_dir / "postprocess" / "plot_breakage.py").string(),
+            "--summary", (dir / "summary.csv").string(), "--fractions", (dir / "fractions.csv").string(),
+            "--out", (dir / "plots").string(), "--threshold", num(thr)};
+  c.cwd = dir;
+  c.log = dir / "plots.log";
+  c.job = "breakage/plots";
+  ctx.runner.run(c);
+  ctx.progress.info(fmt::format("[breakage] results: {}/summary.csv, fractions.csv, breakage.h5, plots/*.png", dir.string()));
 }
 
 }  // namespace mill

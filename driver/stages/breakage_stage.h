@@ -1,4 +1,7 @@
-// Stage 'breakage': impact of one bonded ore lump per condition, fragment analysis
+// Stage 'breakage': one bonded-lump impact per (velocity, angle, repeat),
+// each followed by the fragment analysis; finalize merges the campaign into
+// breakage/summary.csv, fractions.csv, breakage.h5, plots and the critical
+// velocity.
 #pragma once
 
 #include "stages/stage.h"
@@ -8,10 +11,18 @@ namespace mill {
 class BreakageStage : public Stage {
  public:
   std::string name() const override { return "breakage"; }
-  std::string description() const override { return "impact of one bonded ore lump per condition, fragment analysis"; }
-  bool implemented() const override { return false; }
+  std::string description() const override {
+    return "impact of one bonded ore lump per condition, fragment analysis";
+  }
   Plan plan(const StageContext& ctx) const override;
   void run_job(StageContext& ctx, const JobSpec& job, const std::filesystem::path& job_dir) override;
+  void finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) override;
 };
+
+// One impact into `out_dir` (used by run_job and by `orchestrate impact`):
+// runs the deck, analyses the fragments, writes summary.csv, fractions.csv,
+// impact.h5, fragments.vtp and result.json there. Returns the summary line.
+std::string run_impact(StageContext& ctx, double velocity, double angle, int repeat,
+                       const std::filesystem::path& out_dir, const std::string& label);
 
 }  // namespace mill

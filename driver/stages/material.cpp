@@ -1,0 +1,76 @@
+// Ore material and bond parameters for the decks.
+#include "stages/material.h"
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include "engine/liggghts.h"
+#include "jobs/job_store.h"
+#include "stages/stage_util.h"
+
+namespace mill {
+namespace fs = std::filesystem;
+
+std::string ore_hash(const config::Document& ore) { return jobs::job_id(ore_keys(ore)); }
+
+BondParams estimate_bond_params(const config::Document& ore, double radius_multiplier) {
+  // Starting point only; `--stage calibrate` replaces it. Potyondy & Cundall
+  // (2004, sec. 3 and table 1) report macro E close to the bond modulus for
+  // radius multiplier 1 and kn/ks = 2.5 for nu ~ 0.2; a parallel-bond packing's
+  // macro tensile strength is a fraction (~0.5) of the bond tensile strength.
+  // The Mohr-Coulomb shear strength (cohesion + tan(phi) sigma_c) lets the
+  // compressive/tensile ratio exceed what pure tension/shear bonds reach.
+  BondParams b;
+  b.modulus = ore.real("youngs_modulus");
+  b.stiffness_ratio = 2.5;
+  b.tensile = 2.0 * ore.real("tensile_strength");
+  b.cohesion = 2.0 * b.tensile;
+  b.friction_angle_deg = 30.0;
+  b.radius_multiplier = radius_multiplier;
+  b.origin = "closed-form estimate (not calibrated: run --stage calibrate)";
+  return b;
+}
+
+namespace {
+// Read calibrated.* from a YAML file if fitted to `hash`; false otherwise.
+bool read_calibrated(const fs::path& file, const std::string& hash, BondParams& b) {
+  if (!fs::exists(file)) return false;
+  YAML::Node root = YAML::LoadFile(file.string());
+  YAML::Node c = root["calibrated"];
+  if (!c || !c["input_hash"] || c["input_hash"].as<std::string>() != hash) return false;
+  b.modulus = c["bond_modulus"].as<double>();
+  b.stiffness_ratio = c["stiffness_ratio"].as<double>();
+  b.tensile = c["bond_tensile_strength"].as<double>();
+  b.cohesion = c["bond_cohesion"].as<double>();
+  b.friction_angle_deg = c["bond_friction_angle"].as<double>();
+  b.origin = "calibrated (" + file.string() + ")";
+  return true;
+}
+}  // namespace
+
+BondParams bond_params_for(const config::CaseConfig& cfg, const fs::path& run_dir) {
+  const double lambda = cfg.doc.real("lump.bond_radius_multiplier");
+  BondParams b = estimate_bond_params(cfg.ore, lambda);
+  const std::string hash = ore_hash(cfg.ore);
+  BondParams c = b;
+  if (read_calibrated(run_dir / "calibrate" / "calibrated.yaml", hash, c)) return c;
+  if (read_calibrated(cfg.ore_file, hash, c)) return c;
+  return b;
+}
+
+std::vector<std::pair<std::string, std::string>> material_vars(const config::Document& ore, const BondParams& b) {
+  using engine::num;
+  return {{"E", num(ore.real("youngs_modulus"))},
+          {"nu", num(ore.real("poisson_ratio"))},
+          {"density", num(ore.real("density"))},
+          {"restitution", num(ore.real("restitution"))},
+          {"friction", num(ore.real("friction"))},
+          {"bond_modulus", num(b.modulus)},
+          {"stiffness_ratio", num(b.stiffness_ratio)},
+          {"bond_tensile", num(b.tensile)},
+          {"bond_cohesion", num(b.cohesion)},
+          {"bond_friction", num(b.friction_angle_deg)},
+          {"radius_mult", num(b.radius_multiplier)}};
+}
+
+}  // namespace mill
