@@ -12,6 +12,7 @@
 #include "config/schema.h"
 #include "engine/runner.h"
 #include "pipeline.h"
+#include "stages/stage.h"
 
 namespace mill {
 namespace fs = std::filesystem;
@@ -67,6 +68,33 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
   app.add_flag("--print-schema", print_schema, "Print every case-file and ore-card key as Markdown");
   app.add_flag("--check", check, "Validate the case file and its ore card, then exit");
 
+  // orchestrate impact: one impact, for trying things.
+  double imp_velocity = 0, imp_angle = 90;
+  std::string imp_ore;
+  long imp_elements = 0;
+  int imp_repeat = 0;
+  CLI::App* impact = app.add_subcommand(
+      "impact", "One lump impact (deck + fragment analysis) into --output; prints its figures");
+  const CLI::Validator positive_speed(
+      [](std::string& in) -> std::string {
+        try {
+          if (std::stod(in) > 0) return "";
+        } catch (const std::exception&) {
+        }
+        return "expected a speed > 0 m/s, got '" + in + "'";
+      },
+      "SPEED>0");
+  impact->add_option("-v,--velocity", imp_velocity, "Impact speed, m/s")->required()->check(positive_speed);
+  impact->add_option("-a,--angle", imp_angle, "Angle to the surface, deg (90 = normal)")
+      ->check(CLI::Range(0.001, 90.0))
+      ->capture_default_str();
+  impact->add_option("--ore", imp_ore, "Ore card (file or bundled name, e.g. granite); default: the case's");
+  impact->add_option("--elements", imp_elements, "Elements in the lump; default: the case's lump.n_elements")
+      ->check(CLI::Range(2L, 10000000L));
+  impact->add_option("--repeat", imp_repeat, "Repeat index (random orientation)")->check(CLI::NonNegativeNumber);
+  impact->footer("\nExample:\n  orchestrate impact --velocity 100 --angle 60 --ore granite --elements 400 --output try1\n");
+  impact->fallthrough();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -85,6 +113,18 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
     return 0;
   }
   try {
+    if (*impact) {
+      std::vector<std::pair<std::string, std::string>> ov;
+      if (!imp_ore.empty()) ov.push_back({"ore.card", "'" + imp_ore + "'"});
+      if (imp_elements > 0) ov.push_back({"lump.n_elements", std::to_string(imp_elements)});
+      const auto cfg = config::load_case(case_file, project_dir(), ov);
+      const fs::path out_dir = output.empty() ? fs::path("runs") / fmt::format("impact_v{:g}_a{:g}", imp_velocity, imp_angle)
+                                              : fs::path(output);
+      RunOptions opts;
+      opts.output = out_dir;
+      opts.np = np > 0 ? np : static_cast<int>(cfg.doc.integer("resources.np"));
+      return run_single_impact(cfg, opts, imp_velocity, imp_angle, imp_repeat, out);
+    }
     const auto cfg = config::load_case(case_file, project_dir());
     if (check) {
       out << fmt::format("{}: case '{}' is valid; ore card {} ({})\n", cfg.file.string(), cfg.name,

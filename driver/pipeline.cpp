@@ -15,6 +15,7 @@
 #include "engine/runner.h"
 #include "jobs/job_store.h"
 #include "progress.h"
+#include "stages/breakage_stage.h"
 
 namespace mill {
 namespace fs = std::filesystem;
@@ -210,6 +211,23 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
     // A single array task does not merge; the follow-up (whole stage) run does.
     if (!inv.task) stage.finalize(ctx, plan.jobs);
   }
+  return kExitOk;
+}
+
+int run_single_impact(const config::CaseConfig& cfg, const RunOptions& opts, double velocity, double angle,
+                      int repeat, std::ostream& out) {
+  engine::Runner runner;
+  Progress progress(out, isatty(STDOUT_FILENO) && &out == &std::cout);
+  StageContext ctx{cfg, opts, opts.output, opts.output / "breakage", runner, progress};
+  write_provenance(cfg, opts.output);
+  const std::string label = fmt::format("impact_v{:g}_a{:g}_r{}", velocity, angle, repeat);
+  progress.info(fmt::format("impact: {}-element lump of {} at {:g} m/s, {:g} deg, into {}", cfg.doc.integer("lump.n_elements"),
+                            cfg.ore.str("name"), velocity, angle, opts.output.string()));
+  progress.stage_begin("impact", 1, 0);
+  const std::string line = run_impact(ctx, velocity, angle, repeat, opts.output, label);
+  progress.stage_end();
+  out << line << "\n"
+      << "written: " << (opts.output / "summary.csv").string() << ", fractions.csv, impact.h5, fragments.vtp, result.json\n";
   return kExitOk;
 }
 

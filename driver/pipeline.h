@@ -31,6 +31,10 @@ struct Invocation {
 // Run the invocation; returns an ExitCode (or 128+signal when interrupted).
 int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostream& out);
 
+// `orchestrate impact`: one impact into opts.output (no job bookkeeping).
+int run_single_impact(const config::CaseConfig& cfg, const RunOptions& opts, double velocity, double angle,
+                      int repeat, std::ostream& out);
+
 // Expand "all" to every stage, validate names (ConfigError naming --stage).
 std::vector<std::string> resolve_stages(const std::string& stage);
 

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 namespace mill::config {
@@ -64,9 +65,12 @@ std::string suggest(const Schema& s, const std::string& path) {
 
 class Validator {
  public:
-  Validator(const Schema& s, std::string file) : s_(s), file_(std::move(file)) {}
+  Validator(const Schema& s, std::string file, std::set<std::string> overridden = {})
+      : s_(s), file_(std::move(file)), overridden_(std::move(overridden)) {}
 
+  // Line -1 marks a value given on the command line, not in the file.
   [[noreturn]] void fail(int line, const std::string& key, const std::string& msg) const {
+    if (line < 0) throw ConfigError(fmt::format("command line (overrides {}): {}: {}", file_, key, msg));
     throw ConfigError(fmt::format("{}:{}: {}: {}", file_, line, key, msg));
   }
 
@@ -76,7 +80,7 @@ class Validator {
     for (auto it = map.begin(); it != map.end(); ++it) {
       const std::string name = it->first.as<std::string>();
       const std::string path = prefix.empty() ? name : prefix + "." + name;
-      const int line = line_of(it->first);
+      const int line = overridden_.count(path) ? -1 : line_of(it->first);
       const KeyDef* k = s_.find(path);
       if (k) {
         check_value(*k, it->second, line);
@@ -145,7 +149,8 @@ class Validator {
         } else if (n.IsSequence()) {
           if (n.size() == 0) fail(line, k.path, fmt::format("expected a non-empty {}, got []", type_name(k.type)));
           for (size_t i = 0; i < n.size(); ++i)
-            check_number(k, n[i], line_of(n[i]) ? line_of(n[i]) : line, fmt::format("{}[{}]", k.path, i), integer);
+            check_number(k, n[i], line < 0 ? line : (line_of(n[i]) ? line_of(n[i]) : line), fmt::format("{}[{}]", k.path, i),
+                         integer);
         } else {
           fail(line, k.path, fmt::format("expected {}, got {}", type_name(k.type), scalar_text(n)));
         }
@@ -157,11 +162,13 @@ class Validator {
  private:
   const Schema& s_;
   std::string file_;
+  std::set<std::string> overridden_;
 };
 
 }  // namespace
 
-Document Document::parse(const std::string& text, const std::string& file_label, const Schema& schema) {
+Document Document::parse(const std::string& text, const std::string& file_label, const Schema& schema,
+                         const std::vector<std::pair<std::string, std::string>>& overrides) {
   Document d;
   d.file_ = file_label;
   d.schema_ = &schema;
@@ -173,7 +180,20 @@ Document Document::parse(const std::string& text, const std::string& file_label,
   }
   if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
   if (!root.IsMap()) throw ConfigError(fmt::format("{}:1: expected a YAML mapping of keys at the top level", file_label));
-  Validator v(schema, file_label);
+  for (const auto& [path, value] : overrides) {
+    // Walk/create the sections of the dotted path, then set the leaf.
+    std::vector<YAML::Node> chain{root};
+    size_t start = 0;
+    for (size_t dot = path.find('.'); dot != std::string::npos; start = dot + 1, dot = path.find('.', start)) {
+      const std::string part = path.substr(start, dot - start);
+      if (!chain.back()[part] || !chain.back()[part].IsMap()) chain.back()[part] = YAML::Node(YAML::NodeType::Map);
+      chain.push_back(chain.back()[part]);
+    }
+    chain.back()[path.substr(start)] = YAML::Load(value);
+  }
+  std::set<std::string> overridden;
+  for (const auto& o : overrides) overridden.insert(o.first);
+  Validator v(schema, file_label, overridden);
   v.walk(root, "", d.values_, d.lines_);
   for (const auto& k : schema.keys) {
     if (d.values_.count(k.path)) continue;
@@ -245,6 +265,7 @@ int Document::line(const std::string& path) const {
 }
 std::string Document::where(const std::string& path) const {
   const int l = line(path);
+  if (l < 0) return fmt::format("command line (overrides {}): {}", file_, path);
   return l > 0 ? fmt::format("{}:{}: {}", file_, l, path) : fmt::format("{}: {} (default)", file_, path);
 }
 
@@ -339,12 +360,18 @@ fs::path resolve_ore(const Document& d, const fs::path& case_file, const fs::pat
 
 }  // namespace
 
-CaseConfig load_case(const fs::path& file, const fs::path& project_dir) {
+CaseConfig load_case(const fs::path& file, const fs::path& project_dir,
+                     const std::vector<std::pair<std::string, std::string>>& overrides) {
   if (!fs::exists(file)) throw ConfigError(fmt::format("{}: case file not found", file.string()));
   CaseConfig c;
   c.file = fs::weakly_canonical(file);
   c.project_dir = project_dir;
-  c.doc = Document::load(file, case_schema());
+  {
+    std::ifstream in(file);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    c.doc = Document::parse(ss.str(), file.string(), case_schema(), overrides);
+  }
   check_case(c.doc);
   c.name = c.doc.has("name") ? c.doc.str("name") : file.stem().string();
   for (char ch : c.name)

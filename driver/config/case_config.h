@@ -24,7 +24,8 @@ struct ConfigError : std::runtime_error {
 class Document {
  public:
   static Document load(const std::filesystem::path& file, const Schema& schema);
-  static Document parse(const std::string& text, const std::string& file_label, const Schema& schema);
+  static Document parse(const std::string& text, const std::string& file_label, const Schema& schema,
+                        const std::vector<std::pair<std::string, std::string>>& overrides = {});
 
   bool has(const std::string& path) const;
   double real(const std::string& path) const;
@@ -60,7 +61,10 @@ struct CaseConfig {
 };
 
 // Load a case: schema validation, cross-key checks, ore card resolution.
-CaseConfig load_case(const std::filesystem::path& file, const std::filesystem::path& project_dir);
+// `overrides` (dotted key -> YAML value) replace keys of the file before
+// validation, e.g. {"lump.n_elements", "400"} from a command-line option.
+CaseConfig load_case(const std::filesystem::path& file, const std::filesystem::path& project_dir,
+                     const std::vector<std::pair<std::string, std::string>>& overrides = {});
 
 // Physical consistency of an ore card (UCS > tensile strength, ...).
 void check_ore(const Document& ore);

@@ -1,0 +1,162 @@
+// The breakage stage end to end with real LIGGGHTS runs: a tiny campaign's
+// physics trends, resuming, a kill mid-campaign, and `orchestrate impact`.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <thread>
+
+#include "jobs/job_store.h"
+#include "postprocess/breakage_results.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kData = MILL_TEST_DATA;
+
+fs::path scratch(const std::string& name) {
+  fs::path d = fs::temp_directory_path() / ("mill_e2e_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+// Run orchestrate to completion; returns its exit status, output in `log`.
+int orchestrate(const std::string& args, const fs::path& log) {
+  const std::string cmd = "MILL_LIGGGHTS='" + std::string(LIGGGHTS_MILL_EXE) + "' '" + ORCHESTRATE_EXE + "' " + args +
+                          " > '" + log.string() + "' 2>&1";
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+std::string slurp(const fs::path& f) {
+  std::ifstream in(f);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// One campaign shared by the tests below (3 impacts of a 200-element lump).
+class TinyCampaign : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(scratch("campaign"));
+    status_ = orchestrate("--case " + kData + "/tiny_breakage.yaml --stage breakage --output " + dir_->string(),
+                          *dir_ / "first.log");
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static fs::path* dir_;
+  static int status_;
+};
+fs::path* TinyCampaign::dir_ = nullptr;
+int TinyCampaign::status_ = -1;
+
+TEST_F(TinyCampaign, RunsAndWritesEveryOutput) {
+  ASSERT_EQ(status_, 0) << slurp(*dir_ / "first.log");
+  for (const char* f : {"summary.csv", "fractions.csv", "breakage.h5", "critical_velocity.json",
+                        "plots/largest_vs_velocity.png", "plots/pieces_vs_velocity.png", "plots/mass_distribution.png",
+                        "jobs/v20_a90_r0/fragments.vtp", "jobs/v20_a90_r0/result.json"})
+    EXPECT_TRUE(fs::exists(*dir_ / "breakage" / f)) << f;
+}
+
+TEST_F(TinyCampaign, SlowImpactBouncesIntactFastOneShatters) {
+  ASSERT_EQ(status_, 0);
+  const auto rows = mill::post::ReadSummaryCsv((*dir_ / "breakage" / "summary.csv").string());
+  ASSERT_EQ(rows.size(), 3u);
+  const auto& slow = rows[0];
+  EXPECT_DOUBLE_EQ(slow.velocity_m_s, 1.0);
+  EXPECT_EQ(slow.n_pieces, 1);
+  EXPECT_EQ(slow.broken_bond_fraction, 0.0);
+  EXPECT_DOUBLE_EQ(slow.largest_mass_fraction, 1.0);
+  const auto& fast = rows[2];
+  EXPECT_DOUBLE_EQ(fast.velocity_m_s, 150.0);
+  EXPECT_LT(fast.largest_mass_fraction, 0.10);
+  // Along the sweep: more pieces, smaller largest piece.
+  for (size_t i = 1; i < rows.size(); ++i) {
+    EXPECT_GT(rows[i].n_pieces, rows[i - 1].n_pieces);
+    EXPECT_LT(rows[i].largest_mass_fraction, rows[i - 1].largest_mass_fraction);
+  }
+  for (const auto& r : rows) EXPECT_EQ(r.n_elements, 200);
+}
+
+TEST_F(TinyCampaign, SizeFractionsSumToOnePerImpact) {
+  ASSERT_EQ(status_, 0);
+  std::ifstream in(*dir_ / "breakage" / "fractions.csv");
+  std::string line;
+  std::getline(in, line);
+  std::map<std::string, double> sum;
+  while (std::getline(in, line)) {
+    const auto last = line.rfind(',');
+    const std::string key = line.substr(0, line.find(',', line.find(',', line.find(',') + 1) + 1));
+    sum[key] += std::stod(line.substr(last + 1));
+  }
+  ASSERT_EQ(sum.size(), 3u);
+  for (const auto& [k, s] : sum) EXPECT_NEAR(s, 1.0, 1e-9) << k;
+}
+
+TEST_F(TinyCampaign, RerunSkipsDoneJobs) {
+  ASSERT_EQ(status_, 0);
+  const auto t0 = fs::last_write_time(*dir_ / "breakage/jobs/v20_a90_r0/STATUS");
+  const int st = orchestrate("--case " + kData + "/tiny_breakage.yaml --stage breakage --output " + dir_->string(),
+                             *dir_ / "second.log");
+  EXPECT_EQ(st, 0) << slurp(*dir_ / "second.log");
+  EXPECT_NE(slurp(*dir_ / "second.log").find("3 already done"), std::string::npos) << slurp(*dir_ / "second.log");
+  EXPECT_EQ(fs::last_write_time(*dir_ / "breakage/jobs/v20_a90_r0/STATUS"), t0);
+}
+
+// SIGTERM mid-campaign: finished jobs stay done, the running one is marked
+// failed (never done), and a rerun completes without redoing finished jobs.
+TEST(KillResume, KilledCampaignResumes) {
+  const fs::path dir = scratch("kill");
+  const std::string args = "--case " + kData + "/tiny_breakage.yaml --stage breakage --jobs 1 --output " + dir.string();
+  pid_t pid = fork();
+  if (pid == 0) {
+    setenv("MILL_LIGGGHTS", LIGGGHTS_MILL_EXE, 1);
+    const std::string log = (dir / "killed.log").string();
+    freopen(log.c_str(), "w", stdout);
+    freopen(log.c_str(), "a", stderr);
+    execl(ORCHESTRATE_EXE, ORCHESTRATE_EXE, "--case", (kData + "/tiny_breakage.yaml").c_str(), "--stage", "breakage",
+          "--jobs", "1", "--output", dir.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Wait until the first job is done and the second is running, then kill.
+  const fs::path first = dir / "breakage/jobs/v1_a90_r0/STATUS", second = dir / "breakage/jobs/v20_a90_r0/STATUS";
+  auto state = [](const fs::path& f) { return mill::jobs::JobStore(f.parent_path().parent_path().parent_path())
+                                                  .read_status(f.parent_path().filename().string()).state; };
+  bool ready = false;
+  for (int i = 0; i < 1200 && !ready; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    ready = fs::exists(first) && state(first) == mill::jobs::State::Done && fs::exists(second) &&
+            state(second) == mill::jobs::State::Running;
+  }
+  ASSERT_TRUE(ready) << slurp(dir / "killed.log");
+  kill(pid, SIGTERM);
+  int st = 0;
+  waitpid(pid, &st, 0);
+  ASSERT_TRUE(WIFEXITED(st));
+  EXPECT_EQ(WEXITSTATUS(st), 128 + SIGTERM) << slurp(dir / "killed.log");
+  EXPECT_EQ(state(second), mill::jobs::State::Failed);
+  EXPECT_FALSE(fs::exists(dir / "breakage/jobs/v20_a90_r0/summary.csv"));
+  const auto t_first = fs::last_write_time(first);
+
+  EXPECT_EQ(orchestrate(args, dir / "resumed.log"), 0) << slurp(dir / "resumed.log");
+  EXPECT_EQ(fs::last_write_time(first), t_first) << "the finished job was redone";
+  EXPECT_EQ(mill::post::ReadSummaryCsv((dir / "breakage/summary.csv").string()).size(), 3u);
+}
+
+TEST(ImpactCommand, WritesOneRowInItsFolder) {
+  const fs::path dir = scratch("impact");
+  const int st = orchestrate("impact --velocity 2 --elements 120 --output " + dir.string(), dir / "impact.log");
+  ASSERT_EQ(st, 0) << slurp(dir / "impact.log");
+  const auto rows = mill::post::ReadSummaryCsv((dir / "summary.csv").string());
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].n_elements, 120);
+  EXPECT_DOUBLE_EQ(rows[0].velocity_m_s, 2.0);
+  EXPECT_TRUE(fs::exists(dir / "fractions.csv"));
+  EXPECT_NE(slurp(dir / "impact.log").find("pieces"), std::string::npos);
+}
+
+}  // namespace
