@@ -1,16 +1,196 @@
-// Stage 'report': report/index.html and report/summary.json (issue 8).
+// Stage 'report': report/index.html (self-contained: pictures embedded) and
+// report/summary.json from the declared outputs of every stage that ran.
 #include "stages/report_stage.h"
 
-namespace mill {
+#include <fmt/format.h>
+#include <sys/stat.h>
 
-Plan ReportStage::plan(const StageContext&) const {
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+#include "jobs/job_store.h"
+#include "postprocess/breakage_results.h"
+#include "progress.h"
+
+namespace mill {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string slurp(const fs::path& f) {
+  std::ifstream in(f, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+std::string base64(const std::string& in) {
+  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  size_t i = 0;
+  for (; i + 2 < in.size(); i += 3) {
+    const unsigned n = (static_cast<unsigned char>(in[i]) << 16) | (static_cast<unsigned char>(in[i + 1]) << 8) |
+                       static_cast<unsigned char>(in[i + 2]);
+    out += {t[n >> 18], t[(n >> 12) & 63], t[(n >> 6) & 63], t[n & 63]};
+  }
+  if (i + 1 == in.size()) {
+    const unsigned n = static_cast<unsigned char>(in[i]) << 16;
+    out += {t[n >> 18], t[(n >> 12) & 63], '=', '='};
+  } else if (i + 2 == in.size()) {
+    const unsigned n = (static_cast<unsigned char>(in[i]) << 16) | (static_cast<unsigned char>(in[i + 1]) << 8);
+    out += {t[n >> 18], t[(n >> 12) & 63], t[(n >> 6) & 63], '='};
+  }
+  return out;
+}
+
+std::string esc(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '<') o += "&lt;";
+    else if (c == '>') o += "&gt;";
+    else if (c == '&') o += "&amp;";
+    else if (c == '"') o += "&quot;";
+    else o += c;
+  }
+  return o;
+}
+
+std::string fmt_value(const nlohmann::json& v) {
+  if (v.is_number_float()) return fmt::format("{:.4g}", v.get<double>());
+  if (v.is_string()) return esc(v.get<std::string>());
+  if (v.is_null()) return "-";
+  return esc(v.dump());
+}
+
+// Every file the report reads, under the stage folders it knows.
+std::vector<fs::path> report_inputs(const fs::path& run) {
+  std::vector<fs::path> files;
+  for (const char* stage : {"flow", "sample", "transport", "calibrate", "breakage"}) {
+    const fs::path d = run / stage;
+    if (!fs::is_directory(d)) continue;
+    for (auto it = fs::recursive_directory_iterator(d); it != fs::recursive_directory_iterator(); ++it) {
+      const fs::path p = it->path();
+      if (it->is_directory() && (p.filename() == "jobs" || p.filename() == "lumps" || p.filename() == "case" ||
+                                 p.filename() == "run" || p.filename().string().rfind("processor", 0) == 0)) {
+        it.disable_recursion_pending();
+        continue;
+      }
+      const std::string ext = p.extension().string();
+      if (it->is_regular_file() && (ext == ".png" || ext == ".json" || ext == ".csv" || ext == ".md"))
+        files.push_back(p);
+    }
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// A JSON object as a two-column table (nested objects flattened with dots).
+void json_table(std::ostringstream& o, const nlohmann::json& j, const std::string& prefix = "") {
+  if (prefix.empty()) o << "<table>\n";
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
+    if (it->is_object()) json_table(o, *it, key);
+    else o << "<tr><td>" << esc(key) << "</td><td>" << fmt_value(*it) << "</td></tr>\n";
+  }
+  if (prefix.empty()) o << "</table>\n";
+}
+
+}  // namespace
+
+Plan ReportStage::plan(const StageContext& ctx) const {
   Plan p;
-  p.jobs.push_back({"report", nlohmann::json::object(), "report/index.html from every stage's outputs"});
+  // The report is rebuilt whenever any file it reads changed (size, time).
+  nlohmann::json in = nlohmann::json::array();
+  for (const auto& f : report_inputs(ctx.run_dir)) {
+    struct stat st {};
+    stat(f.c_str(), &st);
+    in.push_back({fs::relative(f, ctx.run_dir).string(), static_cast<long long>(st.st_size),
+                  static_cast<long long>(st.st_mtime)});
+  }
+  p.jobs.push_back({"report", {{"inputs", in}, {"report_version", 1}},
+                    "report/index.html and report/summary.json from every stage's outputs"});
   return p;
 }
 
-void ReportStage::run_job(StageContext&, const JobSpec&, const std::filesystem::path&) {
-  throw NotImplemented("stage 'report' is not implemented yet (issue 8: report and mill product)");
+void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
+  const fs::path run = ctx.run_dir, out_dir = ctx.stage_dir;
+  const auto inputs = report_inputs(run);
+  nlohmann::json summary = {{"case", ctx.cfg.name}, {"ore", ctx.cfg.ore.str("name")}};
+  std::ostringstream o;
+  o << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>Beater mill: " << esc(ctx.cfg.name)
+    << "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
+       "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}"
+       "td:first-child{text-align:left}img{max-width:100%;border:1px solid #eee;margin:0.5em 0}"
+       "h2{border-bottom:2px solid #468;padding-bottom:2px}.note{color:#666}</style></head><body>\n";
+  o << "<h1>Beater mill: case " << esc(ctx.cfg.name) << "</h1>\n";
+  if (ctx.cfg.doc.has("description")) o << "<p>" << esc(ctx.cfg.doc.str("description")) << "</p>\n";
+  o << "<p class=note>Case file <code>" << esc(ctx.cfg.file.string()) << "</code>, ore card <code>"
+    << esc(ctx.cfg.ore_file.string()) << "</code>. Every figure is embedded; its data file is linked.</p>\n";
+
+  o << "<h2>Case and ore card</h2>\n";
+  json_table(o, ctx.cfg.ore.to_json());
+  o << "<details><summary>All case keys (defaults included)</summary>\n";
+  json_table(o, ctx.cfg.doc.to_json());
+  o << "</details>\n";
+
+  const std::vector<std::pair<std::string, std::string>> sections = {
+      {"flow", "Stage 1a: gas flow (OpenFOAM)"},
+      {"sample", "Stage 1a: sampled velocity field"},
+      {"transport", "Stage 1b: ore lumps through the mill"},
+      {"calibrate", "Calibration of the bond model"},
+      {"breakage", "Stage 2: breakage of one lump"}};
+  for (const auto& [stage, title] : sections) {
+    std::vector<fs::path> mine;
+    for (const auto& f : inputs)
+      if (fs::relative(f, run).begin()->string() == stage) mine.push_back(f);
+    o << "<h2>" << esc(title) << "</h2>\n";
+    if (mine.empty()) {
+      o << "<p class=note>No results: stage '" << stage << "' has not run (<code>orchestrate --stage " << stage
+        << "</code>).</p>\n";
+      continue;
+    }
+    for (const auto& f : mine) {
+      const std::string rel = fs::relative(f, out_dir).string();
+      const std::string name = fs::relative(f, run).string();
+      if (f.extension() == ".json") {
+        nlohmann::json j;
+        try {
+          j = nlohmann::json::parse(slurp(f));
+        } catch (const std::exception&) {
+          continue;
+        }
+        o << "<h3>" << esc(name) << "</h3>\n";
+        if (j.is_object()) json_table(o, j);
+        else if (j.is_array())
+          for (const auto& e : j)
+            if (e.is_object()) json_table(o, e);
+        summary[name] = j;
+      } else if (f.extension() == ".png") {
+        o << "<figure><img alt=\"" << esc(name) << "\" src=\"data:image/png;base64," << base64(slurp(f))
+          << "\"><figcaption>" << esc(name) << "</figcaption></figure>\n";
+      } else if (f.extension() == ".csv" || f.extension() == ".md") {
+        o << "<p>Data: <a href=\"" << esc(rel) << "\">" << esc(name) << "</a></p>\n";
+      }
+    }
+    if (stage == "breakage" && fs::exists(run / "breakage" / "summary.csv")) {
+      const auto rows = post::ReadSummaryCsv((run / "breakage" / "summary.csv").string());
+      o << "<table><tr><th>V [m/s]</th><th>angle [deg]</th><th>repeat</th><th>pieces</th><th>single</th>"
+           "<th>multi</th><th>largest [%]</th><th>single mass [%]</th><th>broken bonds [%]</th><th>E [kWh/t]</th>"
+           "<th>t10 [%]</th></tr>\n";
+      for (const auto& r : rows)
+        o << fmt::format(
+            "<tr><td>{:g}</td><td>{:g}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.1f}</td>"
+            "<td>{:.1f}</td><td>{:.3g}</td><td>{:.1f}{}</td></tr>\n",
+            r.velocity_m_s, r.angle_deg, r.repeat, r.n_pieces, r.n_single, r.n_multi, 100 * r.largest_mass_fraction,
+            100 * r.single_mass_fraction, 100 * r.broken_bond_fraction, r.specific_energy_kWh_t, r.t10_percent,
+            r.t10_resolved ? "" : "*");
+      o << "</table><p class=note>* t10 not resolved: single elements are coarser than a tenth of the lump.</p>\n";
+      summary["breakage_impacts"] = rows.size();
+    }
+  }
+  o << "<hr><p class=note>Generated by orchestrate " << MILL_VERSION << ".</p></body></html>\n";
+  jobs::atomic_write(out_dir / "index.html", o.str());
+  jobs::atomic_write(out_dir / "summary.json", summary.dump(2) + "\n");
+  ctx.progress.info("[report] " + (out_dir / "index.html").string());
 }
 
 }  // namespace mill

@@ -1,4 +1,5 @@
-// Stage 'report': the HTML report and headline numbers
+// Stage 'report': report/index.html (self-contained, opens offline) and
+// report/summary.json, from the declared outputs of the stages that ran.
 #pragma once
 
 #include "stages/stage.h"
@@ -9,7 +10,6 @@ class ReportStage : public Stage {
  public:
   std::string name() const override { return "report"; }
   std::string description() const override { return "the HTML report and headline numbers"; }
-  bool implemented() const override { return false; }
   Plan plan(const StageContext& ctx) const override;
   void run_job(StageContext& ctx, const JobSpec& job, const std::filesystem::path& job_dir) override;
 };

@@ -10,6 +10,8 @@
 #include <fstream>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "jobs/job_store.h"
 #include "postprocess/breakage_results.h"
 
@@ -157,6 +159,23 @@ TEST(ImpactCommand, WritesOneRowInItsFolder) {
   EXPECT_DOUBLE_EQ(rows[0].velocity_m_s, 2.0);
   EXPECT_TRUE(fs::exists(dir / "fractions.csv"));
   EXPECT_NE(slurp(dir / "impact.log").find("pieces"), std::string::npos);
+}
+
+}  // namespace
+
+namespace {
+
+TEST_F(TinyCampaign, ReportEmbedsTheBreakageResults) {
+  ASSERT_EQ(status_, 0);
+  const int st = orchestrate("--case " + kData + "/tiny_breakage.yaml --stage report --output " + dir_->string(),
+                             *dir_ / "report.log");
+  ASSERT_EQ(st, 0) << slurp(*dir_ / "report.log");
+  const std::string html = slurp(*dir_ / "report/index.html");
+  EXPECT_NE(html.find("Stage 2: breakage of one lump"), std::string::npos);
+  EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
+  EXPECT_NE(html.find("has not run"), std::string::npos);  // flow etc. did not run here
+  const auto summary = nlohmann::json::parse(slurp(*dir_ / "report/summary.json"));
+  EXPECT_EQ(summary.at("breakage_impacts").get<int>(), 3);
 }
 
 }  // namespace
