@@ -11,6 +11,7 @@
 #include "config/case_config.h"
 #include "config/schema.h"
 #include "engine/runner.h"
+#include "hpc.h"
 #include "pipeline.h"
 #include "stages/stage.h"
 
@@ -95,6 +96,19 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
   impact->footer("\nExample:\n  orchestrate impact --velocity 100 --angle 60 --ore granite --elements 400 --output try1\n");
   impact->fallthrough();
 
+  // orchestrate hpc: scheduler scripts for one stage.
+  HpcOptions hpc_opt;
+  CLI::App* hpc = app.add_subcommand("hpc", "Write Slurm job-array scripts for one stage (one task per job)");
+  hpc->add_option("--scheduler", hpc_opt.scheduler, "Scheduler (slurm)")->capture_default_str();
+  hpc->add_option("--partition", hpc_opt.partition, "Slurm partition");
+  hpc->add_option("--account", hpc_opt.account, "Slurm account");
+  hpc->add_option("--time", hpc_opt.time, "Wall-time limit per array task (HH:MM:SS)")->capture_default_str();
+  hpc->add_option("--mem", hpc_opt.mem, "Memory per task, e.g. 4G");
+  hpc->add_option("--max-parallel", hpc_opt.max_parallel, "At most this many tasks at once (0: no limit)");
+  hpc->footer("\nExample:\n  orchestrate hpc --scheduler slurm --stage breakage --case cases/reference.yaml --np 1\n"
+              "  sh runs/reference/hpc/submit_breakage.sh\n");
+  hpc->fallthrough();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -126,6 +140,19 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
       return run_single_impact(cfg, opts, imp_velocity, imp_angle, imp_repeat, out);
     }
     const auto cfg = config::load_case(case_file, project_dir());
+    if (*hpc) {
+      if (stage.empty()) throw config::ConfigError("--stage: hpc needs the stage whose jobs become array tasks");
+      resolve_stages(stage);
+      hpc_opt.stage = stage;
+      hpc_opt.output = output.empty() ? fs::path("runs") / cfg.name : fs::path(output);
+      hpc_opt.np = np > 0 ? np : static_cast<int>(cfg.doc.integer("resources.np"));
+      Invocation inv;
+      inv.stages = {stage};
+      inv.opts.output = hpc_opt.output;
+      const int n = count_tasks(cfg, inv);
+      out << write_hpc_scripts(cfg, hpc_opt, n, fs::canonical("/proc/self/exe").string());
+      return 0;
+    }
     if (check) {
       out << fmt::format("{}: case '{}' is valid; ore card {} ({})\n", cfg.file.string(), cfg.name,
                          cfg.ore_file.string(), cfg.ore.str("name"));

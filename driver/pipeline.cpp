@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iostream>
 #include <mutex>
+#include <sstream>
 #include <thread>
 
 #include "engine/runner.h"
@@ -212,6 +213,19 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
     if (!inv.task) stage.finalize(ctx, plan.jobs);
   }
   return kExitOk;
+}
+
+int count_tasks(const config::CaseConfig& cfg, const Invocation& inv) {
+  auto stages = make_stages();
+  engine::Runner runner;
+  std::ostringstream sink;
+  Progress progress(sink, false);
+  for (auto& s : stages)
+    if (s->name() == inv.stages.at(0)) {
+      StageContext ctx{cfg, inv.opts, inv.opts.output, inv.opts.output / s->name(), runner, progress};
+      return static_cast<int>(s->plan(ctx).jobs.size());
+    }
+  return 0;
 }
 
 int run_single_impact(const config::CaseConfig& cfg, const RunOptions& opts, double velocity, double angle,

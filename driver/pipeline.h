@@ -35,6 +35,9 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
 int run_single_impact(const config::CaseConfig& cfg, const RunOptions& opts, double velocity, double angle,
                       int repeat, std::ostream& out);
 
+// Number of jobs the (single) stage of `inv` has for this case.
+int count_tasks(const config::CaseConfig& cfg, const Invocation& inv);
+
 // Expand "all" to every stage, validate names (ConfigError naming --stage).
 std::vector<std::string> resolve_stages(const std::string& stage);
 

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <fstream>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -113,6 +114,33 @@ TEST(Cli, PrintSchema) {
   auto o = orchestrate("--print-schema");
   EXPECT_EQ(o.status, 0);
   EXPECT_NE(o.text.find("breakage.velocities"), std::string::npos);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(Cli, HpcWritesArrayAndMergeScripts) {
+  const fs::path out = fs::temp_directory_path() / ("mill_cli_hpc_" + std::to_string(getpid()));
+  fs::remove_all(out);
+  auto o = orchestrate("hpc --scheduler slurm --stage breakage --case " + kData + "/good_small.yaml --np 2 --output " +
+                       out.string());
+  ASSERT_EQ(o.status, 0) << o.text;
+  std::ifstream a(out / "hpc" / "breakage.array.sh");
+  const std::string array((std::istreambuf_iterator<char>(a)), std::istreambuf_iterator<char>());
+  EXPECT_NE(array.find("#SBATCH --array=0-3"), std::string::npos) << array;  // 2 speeds x 2 repeats
+  EXPECT_NE(array.find("--task \"$SLURM_ARRAY_TASK_ID\""), std::string::npos);
+  EXPECT_NE(array.find("#SBATCH --ntasks=2"), std::string::npos);
+  EXPECT_TRUE(fs::exists(out / "hpc" / "breakage.merge.sh"));
+  std::ifstream s(out / "hpc" / "submit_breakage.sh");
+  const std::string submit((std::istreambuf_iterator<char>(s)), std::istreambuf_iterator<char>());
+  EXPECT_NE(submit.find("--dependency=afterok"), std::string::npos);
+}
+
+TEST(Cli, HpcRejectsUnknownScheduler) {
+  auto o = orchestrate("hpc --scheduler pbs --stage breakage");
+  EXPECT_EQ(o.status, 2);
+  EXPECT_NE(o.text.find("--scheduler"), std::string::npos) << o.text;
 }
 
 }  // namespace

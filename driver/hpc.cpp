@@ -1,0 +1,76 @@
+// Slurm job-array scripts for any stage.
+#include "hpc.h"
+
+#include <fmt/format.h>
+#include <sys/stat.h>
+
+#include "jobs/job_store.h"
+
+namespace mill {
+namespace fs = std::filesystem;
+
+namespace {
+std::string quote(const std::string& s) {
+  std::string o = "'";
+  for (char c : s) o += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return o + "'";
+}
+
+std::string header(const HpcOptions& o, const std::string& name, const fs::path& logs, int ntasks) {
+  std::string h = "#!/bin/bash\n";
+  h += fmt::format("#SBATCH --job-name={}\n", name);
+  h += fmt::format("#SBATCH --ntasks={}\n", ntasks);
+  h += fmt::format("#SBATCH --time={}\n", o.time);
+  if (!o.partition.empty()) h += fmt::format("#SBATCH --partition={}\n", o.partition);
+  if (!o.account.empty()) h += fmt::format("#SBATCH --account={}\n", o.account);
+  if (!o.mem.empty()) h += fmt::format("#SBATCH --mem={}\n", o.mem);
+  h += fmt::format("#SBATCH --output={}/%x_%A_%a.out\n", logs.string());
+  return h;
+}
+}  // namespace
+
+std::string write_hpc_scripts(const config::CaseConfig& cfg, const HpcOptions& o, int n_tasks,
+                              const std::string& exe) {
+  if (o.scheduler != "slurm")
+    throw config::ConfigError(fmt::format("--scheduler: expected 'slurm' (the only scheduler supported), got '{}'",
+                                          o.scheduler));
+  if (o.stage == "all")
+    throw config::ConfigError("--stage: expected one stage (an array runs the jobs of one stage), got 'all'");
+  if (n_tasks <= 0)
+    throw config::ConfigError(fmt::format("--stage {}: the stage has no jobs yet (its inputs come from an earlier "
+                                          "stage that has not run)", o.stage));
+  const fs::path out = fs::absolute(o.output), dir = out / "hpc", logs = dir / "logs";
+  fs::create_directories(logs);
+  const std::string common = fmt::format("{} --case {} --output {} --stage {}", quote(exe), quote(cfg.file.string()),
+                                         quote(out.string()), o.stage);
+  const std::string array_name = fmt::format("mill-{}-{}", cfg.name, o.stage);
+  std::string array = header(o, array_name, logs, o.np);
+  array += fmt::format("#SBATCH --array=0-{}{}\n", n_tasks - 1, o.max_parallel > 0 ? fmt::format("%{}", o.max_parallel) : "");
+  array += "# One array task per job of `orchestrate --stage " + o.stage + " --list-tasks`.\n";
+  array += "# A task that finds its job done (same inputs) returns at once: resubmitting is safe.\n";
+  array += "set -euo pipefail\n";
+  array += fmt::format("exec {} --task \"$SLURM_ARRAY_TASK_ID\" --np {} --jobs 1\n", common, o.np);
+
+  std::string merge = header(o, array_name + "-merge", logs, 1);
+  merge += "# After every array task succeeded: merge the stage's results and write the report.\n";
+  merge += "set -euo pipefail\n";
+  merge += fmt::format("{} --jobs 1\n", common);
+  merge += fmt::format("{} --case {} --output {} --stage report\n", quote(exe), quote(cfg.file.string()),
+                       quote(out.string()));
+
+  std::string submit = "#!/bin/sh\n# Submit the array, then the merge job once every task succeeded.\nset -eu\n";
+  submit += fmt::format("array=$(sbatch --parsable {})\n", quote((dir / (o.stage + ".array.sh")).string()));
+  submit += fmt::format("merge=$(sbatch --parsable --dependency=afterok:\"${{array%%;*}}\" {})\n",
+                        quote((dir / (o.stage + ".merge.sh")).string()));
+  submit += "echo \"submitted array job $array and merge job $merge\"\n";
+
+  const fs::path a = dir / (o.stage + ".array.sh"), m = dir / (o.stage + ".merge.sh"), s = dir / ("submit_" + o.stage + ".sh");
+  jobs::atomic_write(a, array);
+  jobs::atomic_write(m, merge);
+  jobs::atomic_write(s, submit);
+  for (const auto& f : {a, m, s}) chmod(f.c_str(), 0755);
+  return fmt::format("wrote {} ({} array tasks, {} MPI rank{} each), {} and {}\nsubmit with: sh {}\n", a.string(),
+                     n_tasks, o.np, o.np == 1 ? "" : "s", m.string(), s.string(), s.string());
+}
+
+}  // namespace mill
