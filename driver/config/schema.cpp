@@ -99,6 +99,8 @@ Schema make_case_schema() {
       positive(key("injection.time_limit", T::Real, "s", "2.0", "Transport run stops at this time")),
       positive(key("injection.timestep", T::Real, "s", "5e-6", "Particle time step")),
       at_least(key("injection.seed", T::Int, "", "4711", "Random seed of the insertion"), 1),
+      positive(key("transport.trajectory_interval", T::Real, "s", "2e-3", "Trajectory sampling interval (transport.h5, plot)")),
+      at_least(key("transport.vtk_interval", T::Real, "s", "0.01", "VTK dump interval of lumps and meshes (ParaView); 0 = none"), 0),
 
       // --- ore ---
       key("ore.card", T::Path, "", "liggghts_inputs/materials/sandstone.yaml",
@@ -121,7 +123,9 @@ Schema make_case_schema() {
                    "Impact speeds of the sweep")),
       range(key("breakage.angles", T::RealList, "deg", "[90]", "Impact angles to the surface (90 = normal)"), 0, true, 90, false),
       at_least(key("breakage.repeats", T::Int, "", "1", "Repeats per condition (random orientation)"), 1),
-      positive(key("breakage.duration_after_contact", T::Real, "s", "6e-3", "Simulated time after first contact")),
+      positive(key("breakage.duration_after_contact", T::Real, "s", "6e-3", "Simulated time after first contact, at most")),
+      at_least(key("breakage.quiet_time", T::Real, "s", "1e-3",
+                   "Stop earlier once no bond broke for this long after contact; 0 = always the full duration"), 0),
       at_least(key("breakage.timestep", T::Real, "s", "0", "Time step; 0 = automatic from the stability limit"), 0),
       at_least(key("breakage.dump_interval", T::Real, "s", "5e-4", "VTK dump interval; 0 = no dumps"), 0),
       range(key("breakage.size_fraction_edges", T::RealList, "", "[0, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.85, 1.0]",

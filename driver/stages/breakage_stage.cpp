@@ -110,10 +110,11 @@ Plan BreakageStage::plan(const StageContext& ctx) const {
     p.note = "impact conditions come from transport/ (binned flywheel impacts); not implemented yet (issue 8)";
     return p;
   }
-  nlohmann::json base = case_keys(d, {"lump.", "breakage.duration_after_contact", "breakage.timestep"});
+  nlohmann::json base =
+      case_keys(d, {"lump.", "breakage.duration_after_contact", "breakage.timestep", "breakage.quiet_time"});
   base["ore"] = ore_keys(ctx.cfg.ore);
   base["bond"] = bond_json(bond_params_for(ctx.cfg, ctx.run_dir));
-  base["deck_version"] = 1;
+  base["deck_version"] = 2;
   for (double v : d.reals("breakage.velocities"))
     for (double a : d.reals("breakage.angles"))
       for (long r = 0; r < d.integer("breakage.repeats"); ++r) {
@@ -158,6 +159,8 @@ std::string run_impact(StageContext& ctx, double velocity, double angle, int rep
               {"rot_z", num(rot[2])},
               {"rot_angle", num(rot[3])},
               {"t_end", num(t_end)},
+              {"t_contact", num(t_contact)},
+              {"quiet_time", num(d.real("breakage.quiet_time"))},
               {"dt", num(d.real("breakage.timestep"))},
               {"skin", num(0.3 * lump.mean_radius)},
               {"dump_interval", num(d.real("breakage.dump_interval"))},
