@@ -1,0 +1,971 @@
+// fix bond/breakable: parallel-bond model of Potyondy & Cundall (2004) as a
+// LIGGGHTS 3.8 fix. Physics references are cited per line; see the doc page
+// docs/styles/fix_bond_breakable.md for the equations and keywords.
+#include "fix_bond_breakable.h"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <sstream>
+#include <unordered_map>
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "memory.h"
+#include "neighbor.h"
+#include "update.h"
+
+using namespace LAMMPS_NS;
+using namespace FixConst;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kEventCols = 10;  // step time x y z mode tag_a tag_b sigma tau
+constexpr int kMaxBondsLimit = 64;
+
+// Small 3-vector helpers: dot product, cross product c = a x b, Euclidean norm.
+inline double dot3(const double *a, const double *b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+inline void cross3(const double *a, const double *b, double *c) {
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+inline double norm3(const double *a) { return std::sqrt(dot3(a, a)); }
+
+// Moves a stored contact-plane vector v onto the plane normal to n and spins it
+// about n by the small angle theta: the rigid-body update of the contact frame
+// used by PFC3D for the parallel bond (Potyondy & Cundall 2004, sec. 2.2; Itasca
+// PFC manual, "contact force update"). |v| is kept exactly; the spin uses the
+// second-order rotation v cos(theta) + (n x v) sin(theta) with
+// cos ~ 1 - theta^2/2, sin ~ theta (theta = spin x dt << 1 for a stable dt).
+void rotate_onto_plane(double *v, const double *n, double theta) {
+  const double mag0_sq = dot3(v, v);
+  if (mag0_sq < 1e-200) {  // |v| < 1e-100: flush, denormal arithmetic is ~100x slower
+    v[0] = v[1] = v[2] = 0.0;
+    return;
+  }
+  const double vn = dot3(v, n);
+  for (int k = 0; k < 3; ++k) v[k] -= vn * n[k];
+  if (theta != 0.0) {
+    double nxv[3];
+    cross3(n, v, nxv);
+    const double c = 1.0 - 0.5 * theta * theta;
+    for (int k = 0; k < 3; ++k) v[k] = v[k] * c + nxv[k] * theta;
+  }
+  const double mag1_sq = dot3(v, v);
+  if (mag1_sq > 0.0 && mag1_sq != mag0_sq) {
+    const double s = std::sqrt(mag0_sq / mag1_sq);
+    for (int k = 0; k < 3; ++k) v[k] *= s;
+  }
+}
+
+// Parses a number given for keyword key, or fails with a message naming both.
+double parse_number(Error *error, const char *key, const char *text) {
+  char *end = nullptr;
+  errno = 0;
+  const double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
+    std::string msg =
+        std::string("fix bond/breakable: ") + key + " expects a number, got '" + text + "'";
+    error->all(FLERR, msg.c_str());
+  }
+  return v;
+}
+
+// Formats a double the way users wrote it (shortest round-trip-ish form).
+std::string fmt_num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+// Result of one bond evaluation in the canonical frame (a = lower tag).
+struct FixBondBreakable::BondResult {
+  double fa[3];      // total force on a (force on b is -fa)
+  double ta[3];      // torque on a
+  double tb[3];      // torque on b
+  double sigma;      // max tensile stress [Pa]
+  double tau;        // max shear stress [Pa]
+  double strength;   // shear strength at this normal stress [Pa]
+  double energy;     // elastic energy stored in the bond [J]
+  double centre[3];  // bond centre (contact point)
+  int mode;          // 0 intact, 1 tension, 2 shear
+};
+
+// Per-atom arrays read by evaluate_bond, fetched once per step (LIGGGHTS's
+// Pointers members are references to pointers: one load each, not per bond).
+struct FixBondBreakable::AtomArrays {
+  double **x, **v, **omega;
+  double *radius, *rmass;
+  double dt;
+};
+
+/* ---------------------------------------------------------------------- */
+
+// Parses keywords, allocates per-atom storage and registers atom callbacks.
+FixBondBreakable::FixBondBreakable(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg) {
+  parse_args(narg, arg);
+
+  restart_global = 1;
+  restart_peratom = 1;
+  vector_flag = 1;
+  size_vector = 6;
+  global_freq = 1;
+  extvector = 0;
+  peratom_flag = 1;
+  size_peratom_cols = 0;
+  peratom_freq = 1;
+  create_attribute = 1;  // atoms created later start without bonds
+
+  grow_arrays(atom->nmax);
+  atom->add_callback(0);  // grow / copy / exchange
+  atom->add_callback(1);  // restart
+  for (int i = 0; i < atom->nmax; ++i) {
+    nbond_[i] = 0;
+    count_[i] = 0.0;
+  }
+}
+
+// Unregisters callbacks and frees storage; closes the break log.
+FixBondBreakable::~FixBondBreakable() {
+  atom->delete_callback(id, 0);
+  atom->delete_callback(id, 1);
+  memory->destroy(nbond_);
+  memory->destroy(bonds_);
+  memory->destroy(count_);
+  if (break_log_) fclose(break_log_);
+}
+
+// Reads `fix ID group bond/breakable key value ...`; errors name key and value.
+void FixBondBreakable::parse_args(int narg, char **arg) {
+  bool have_modulus = false, have_ratio = false, have_tensile = false, have_cohesion = false;
+  auto fail = [this](const std::string &msg) {
+    std::string m = "fix bond/breakable: " + msg;
+    error->all(FLERR, m.c_str());
+  };
+  int iarg = 3;
+  while (iarg < narg) {
+    const std::string key = arg[iarg];
+    if (iarg + 1 >= narg) fail("keyword '" + key + "' needs a value");
+    const char *val = arg[iarg + 1];
+    if (key == "radius_multiplier") {
+      radius_multiplier_ = parse_number(error, arg[iarg], val);
+      if (!(radius_multiplier_ > 0.0))
+        fail("radius_multiplier must be > 0, got " + std::string(val));
+    } else if (key == "modulus") {
+      modulus_ = parse_number(error, arg[iarg], val);
+      have_modulus = true;
+      if (!(modulus_ > 0.0)) fail("modulus must be > 0 Pa, got " + std::string(val));
+    } else if (key == "stiffness_ratio") {
+      stiffness_ratio_ = parse_number(error, arg[iarg], val);
+      have_ratio = true;
+      if (!(stiffness_ratio_ > 0.0)) fail("stiffness_ratio must be > 0, got " + std::string(val));
+    } else if (key == "tensile_strength") {
+      tensile_strength_ = parse_number(error, arg[iarg], val);
+      have_tensile = true;
+      if (!(tensile_strength_ > 0.0))
+        fail("tensile_strength must be > 0 Pa, got " + std::string(val));
+    } else if (key == "cohesion") {
+      cohesion_ = parse_number(error, arg[iarg], val);
+      have_cohesion = true;
+      if (!(cohesion_ > 0.0)) fail("cohesion must be > 0 Pa, got " + std::string(val));
+    } else if (key == "friction_angle") {
+      friction_angle_ = parse_number(error, arg[iarg], val);
+      if (!(friction_angle_ >= 0.0 && friction_angle_ < 90.0))
+        fail("friction_angle must be in [0, 90) degrees, got " + std::string(val));
+    } else if (key == "damping") {
+      damping_ = parse_number(error, arg[iarg], val);
+      if (!(damping_ >= 0.0)) fail("damping must be >= 0, got " + std::string(val));
+    } else if (key == "gap") {
+      gap_ = parse_number(error, arg[iarg], val);
+      if (!(gap_ >= 0.0)) fail("gap must be >= 0, got " + std::string(val));
+    } else if (key == "max_bonds") {
+      const double v = parse_number(error, arg[iarg], val);
+      if (!(v >= 1.0 && v <= kMaxBondsLimit && v == std::floor(v)))
+        fail("max_bonds must be an integer in [1, " + std::to_string(kMaxBondsLimit) + "], got " +
+             std::string(val));
+      max_bonds_ = static_cast<int>(v);
+    } else if (key == "break_log") {
+      break_log_path_ = val;
+    } else if (key == "dump_bonds") {
+      dump_bonds_path_ = val;
+      if (iarg + 3 < narg && std::strcmp(arg[iarg + 2], "every") == 0) {
+        const double v = parse_number(error, "every", arg[iarg + 3]);
+        if (!(v >= 1.0 && v == std::floor(v)))
+          fail("dump_bonds every must be an integer >= 1 step, got " + std::string(arg[iarg + 3]));
+        dump_every_ = static_cast<int>(v);
+        iarg += 2;
+      }
+    } else {
+      fail("unknown keyword '" + key +
+           "' (expected radius_multiplier, modulus, stiffness_ratio, tensile_strength, cohesion, "
+           "friction_angle, damping, gap, max_bonds, break_log, dump_bonds)");
+    }
+    iarg += 2;
+  }
+  if (!have_modulus) fail("keyword 'modulus' is required (bond Young's modulus, Pa)");
+  if (!have_ratio) fail("keyword 'stiffness_ratio' is required (kn/ks, dimensionless)");
+  if (!have_tensile) fail("keyword 'tensile_strength' is required (Pa)");
+  if (!have_cohesion) fail("keyword 'cohesion' is required (Pa)");
+}
+
+// Hooks: forces after the pair style; optional periodic bond dumps.
+int FixBondBreakable::setmask() {
+  int mask = 0;
+  mask |= POST_FORCE;
+  mask |= POST_RUN;
+  if (dump_every_ > 0) mask |= END_OF_STEP;
+  return mask;
+}
+
+// Checks the atom style and communication settings; finds the radius range.
+void FixBondBreakable::init() {
+  if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
+    error->all(FLERR,
+               "fix bond/breakable: requires per-atom radius, mass, omega and torque "
+               "(use 'atom_style sphere')");
+  if (atom->map_style == 0)
+    error->all(FLERR,
+               "fix bond/breakable: needs the atom map to find bond partners; add "
+               "'atom_modify map array' before the box is created");
+  if (!comm->ghost_velocity)
+    error->all(FLERR,
+               "fix bond/breakable: ghost atoms need velocities; add 'communicate single vel yes' "
+               "(LIGGGHTS's form of 'comm_modify vel yes')");
+
+  double lo = 1e300, hi = 0.0;
+  for (int i = 0; i < atom->nlocal; ++i)
+    if (atom->mask[i] & groupbit) {
+      lo = std::min(lo, atom->radius[i]);
+      hi = std::max(hi, atom->radius[i]);
+    }
+  MPI_Allreduce(&hi, &rmax_, 1, MPI_DOUBLE, MPI_MAX, world);
+  MPI_Allreduce(&lo, &rmin_, 1, MPI_DOUBLE, MPI_MIN, world);
+  if (rmin_ > rmax_) rmin_ = rmax_;
+  tan_friction_ = std::tan(friction_angle_ * kPi / 180.0);
+  inv_ratio_ = 1.0 / stiffness_ratio_;
+  inv_modulus_ = 1.0 / modulus_;
+
+  double lm = 0.0;
+  for (int i = 0; i < atom->nlocal; ++i)
+    for (int k = 0; k < nbond_[i]; ++k) lm = std::max(lm, bonds_[i][k * NCOL + L0]);
+  MPI_Allreduce(&lm, &lmax_, 1, MPI_DOUBLE, MPI_MAX, world);
+
+  if (break_log_path_.size() && comm->me == 0 && !break_log_) {
+    break_log_ = fopen(break_log_path_.c_str(), bonds_created_ ? "a" : "w");
+    if (!break_log_) {
+      std::string m = "fix bond/breakable: cannot open break_log file '" + break_log_path_ + "'";
+      fail_one(m);
+    }
+    if (!bonds_created_)
+      fprintf(break_log_,
+              "# fix bond/breakable break events\n"
+              "# columns: step time[s] x[m] y[m] z[m] mode tag_i tag_j sigma[Pa] tau[Pa]\n");
+  }
+}
+
+// Ghost cutoff that keeps every bond partner among the ghosts. LIGGGHTS's
+// granular comm sends an atom as ghost when it lies within cutghost/2 + skin/2
+// + radius of the sub-domain face (comm_I.h), so cutghost must reach ~2 L.
+double FixBondBreakable::extend_cut_ghost() {
+  double lbond = std::max(lmax_, (2.0 + gap_) * rmax_);
+  lbond *= 1.05;  // bonds stretch before they break (strain at break << 5%)
+  return std::max(0.0, 2.0 * lbond - 2.0 * rmin_);
+}
+
+// First run: creates the bonds. Every run: forces from the stored state.
+void FixBondBreakable::setup(int /*vflag*/) {
+  if (!bonds_created_) {
+    create_bonds();
+    bonds_created_ = 1;
+  }
+  estimate_time_step();
+  compute_bonds(false);
+}
+
+// Each step: advances, checks and applies every bond.
+void FixBondBreakable::post_force(int /*vflag*/) { compute_bonds(true); }
+
+// Writes the periodic bond dump.
+void FixBondBreakable::end_of_step() {
+  if (dump_every_ > 0 && update->ntimestep % dump_every_ == 0) write_bond_dump();
+}
+
+// Writes the bond dump at the end of every run.
+void FixBondBreakable::post_run() {
+  if (!dump_bonds_path_.empty()) write_bond_dump();
+  if (break_log_) fflush(break_log_);
+}
+
+/* ---------------------------------------------------------------------- */
+
+// Prints one line on screen and in the log file (rank 0).
+void FixBondBreakable::message(const std::string &text) const {
+  if (comm->me != 0) return;
+  if (screen) fprintf(screen, "%s\n", text.c_str());
+  if (logfile) fprintf(logfile, "%s\n", text.c_str());
+}
+
+// Stops the run from one rank. The message also goes to stderr first:
+// Error::one aborts MPI, and a buffered screen file would lose the text.
+void FixBondBreakable::fail_one(const std::string &text) const {
+  fprintf(stderr, "ERROR on proc %d: %s\n", comm->me, text.c_str());
+  fflush(stderr);
+  if (logfile) {
+    fprintf(logfile, "ERROR on proc %d: %s\n", comm->me, text.c_str());
+    fflush(logfile);
+  }
+  error->one(FLERR, text.c_str());
+  std::abort();  // not reached: Error::one does not return
+}
+
+// Bonds every pair of group atoms whose surface gap is below gap x min(Ri,Rj).
+// Partners may be ghosts; the test is symmetric so both ends agree.
+void FixBondBreakable::create_bonds() {
+  double **x = atom->x;
+  double *radius = atom->radius;
+  int *tag = atom->tag;
+  int *mask = atom->mask;
+  const int nlocal = atom->nlocal;
+  const int nall = nlocal + atom->nghost;
+
+  // Cell list over owned + ghost atoms; cell edge = longest possible bond.
+  const double h = std::max((2.0 + gap_) * rmax_, 1e-300);
+  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+  for (int i = 0; i < nall; ++i)
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::min(lo[d], x[i][d]);
+      hi[d] = std::max(hi[d], x[i][d]);
+    }
+  int nc[3] = {1, 1, 1};
+  if (nall > 0)
+    for (int d = 0; d < 3; ++d)
+      nc[d] = std::max(1, std::min(256, static_cast<int>((hi[d] - lo[d]) / h) + 1));
+  std::vector<int> head(static_cast<size_t>(nc[0]) * nc[1] * nc[2], -1), next(nall, -1);
+  auto cell_of = [&](const double *p, int *c) {
+    for (int d = 0; d < 3; ++d)
+      c[d] = std::min(nc[d] - 1, std::max(0, static_cast<int>((p[d] - lo[d]) / h)));
+  };
+  for (int i = 0; i < nall; ++i) {
+    if (!(mask[i] & groupbit)) continue;
+    int c[3];
+    cell_of(x[i], c);
+    const size_t id = (static_cast<size_t>(c[2]) * nc[1] + c[1]) * nc[0] + c[0];
+    next[i] = head[id];
+    head[id] = i;
+  }
+
+  struct Candidate {
+    int tag;
+    double dist;
+  };
+  std::vector<Candidate> cand;
+  for (int i = 0; i < nlocal; ++i) {
+    nbond_[i] = 0;
+    if (!(mask[i] & groupbit)) continue;
+    cand.clear();
+    int c[3];
+    cell_of(x[i], c);
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
+          if (cx < 0 || cy < 0 || cz < 0 || cx >= nc[0] || cy >= nc[1] || cz >= nc[2]) continue;
+          for (int j = head[(static_cast<size_t>(cz) * nc[1] + cy) * nc[0] + cx]; j >= 0;
+               j = next[j]) {
+            if (tag[j] == tag[i]) continue;
+            // Canonical difference (lower tag -> higher tag): same bits on both ends.
+            const bool i_first = tag[i] < tag[j];
+            const double *xa = i_first ? x[i] : x[j];
+            const double *xb = i_first ? x[j] : x[i];
+            const double d[3] = {xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]};
+            const double dist = norm3(d);
+            const double rmin_ij = std::min(radius[i], radius[j]);
+            if (dist - radius[i] - radius[j] < gap_ * rmin_ij) {
+              bool dup = false;  // periodic images: keep the closest
+              for (auto &cd : cand)
+                if (cd.tag == tag[j]) {
+                  cd.dist = std::min(cd.dist, dist);
+                  dup = true;
+                }
+              if (!dup) cand.push_back({tag[j], dist});
+            }
+          }
+        }
+    if (static_cast<int>(cand.size()) > max_bonds_) {
+      std::string m = "fix bond/breakable: atom " + std::to_string(tag[i]) + " has " +
+                      std::to_string(cand.size()) + " bond candidates but max_bonds is " +
+                      std::to_string(max_bonds_) + "; raise max_bonds or lower gap";
+      fail_one(m);
+    }
+    std::sort(cand.begin(), cand.end(),
+              [](const Candidate &p, const Candidate &q) { return p.tag < q.tag; });
+    for (const auto &cd : cand) {
+      double *s = &bonds_[i][nbond_[i] * NCOL];
+      for (int k = 0; k < NCOL; ++k) s[k] = 0.0;
+      s[PARTNER] = cd.tag;
+      s[L0] = cd.dist;
+      ++nbond_[i];
+    }
+  }
+
+  // Report: number of bonds and mean coordination of the group.
+  double local[3] = {0.0, 0.0, 0.0}, global[3];
+  for (int i = 0; i < nlocal; ++i)
+    if (mask[i] & groupbit) {
+      local[0] += nbond_[i];
+      local[1] += 1.0;
+      for (int k = 0; k < nbond_[i]; ++k) local[2] = std::max(local[2], bonds_[i][k * NCOL + L0]);
+    }
+  MPI_Allreduce(local, global, 2, MPI_DOUBLE, MPI_SUM, world);
+  MPI_Allreduce(&local[2], &lmax_, 1, MPI_DOUBLE, MPI_MAX, world);
+  const double nb = 0.5 * global[0];
+  const double coord = global[1] > 0.0 ? global[0] / global[1] : 0.0;
+  char line[256];
+  snprintf(line, sizeof(line),
+           "fix bond/breakable: created %.0f bonds among %.0f atoms, mean coordination %.3f "
+           "(gap < %g x min radius)",
+           nb, global[1], coord, gap_);
+  message(line);
+}
+
+// Index of the partner of local atom i for this step (closest periodic image),
+// or an error: a missing partner is never treated as a broken bond.
+int FixBondBreakable::partner_index(int i, int partner_tag) const {
+  int j = atom->map(partner_tag);
+  if (j >= 0 && atom->tag[j] != partner_tag) j = -1;  // stale map entry (deleted atom)
+  if (j < 0) {
+    std::string m = "fix bond/breakable: bond partner " + std::to_string(partner_tag) +
+                    " of atom " + std::to_string(atom->tag[i]) +
+                    " is neither owned nor a ghost on this rank (atom lost, or ghost cutoff too "
+                    "short: raise 'communicate single cutoff')";
+    fail_one(m);
+  }
+  if (domain->xperiodic || domain->yperiodic || domain->zperiodic) j = domain->closest_image(i, j);
+  return j;
+}
+
+// Slot of the bond to partner_tag in atom i's list, or -1.
+int FixBondBreakable::find_slot(int i, int partner_tag) const {
+  const double key = partner_tag;  // tags are stored exactly as doubles
+  const double *row = bonds_[i];
+  for (int k = 0; k < nbond_[i]; ++k)
+    if (row[k * NCOL + PARTNER] == key) return k;
+  return -1;
+}
+
+// Removes slot k of atom i by moving the last slot into it.
+void FixBondBreakable::remove_slot(int i, int k) {
+  const int last = nbond_[i] - 1;
+  if (k != last) std::memcpy(&bonds_[i][k * NCOL], &bonds_[i][last * NCOL], NCOL * sizeof(double));
+  nbond_[i] = last;
+}
+
+// Evaluates the bond between atoms a (lower tag) and b in the canonical frame:
+// advances the history in hist when advance is true, then returns forces,
+// torques, stresses and the breakage verdict.
+void FixBondBreakable::evaluate_bond(const AtomArrays &at, int a, int b, double *hist, bool advance,
+                                     BondResult &out) const {
+  // Inputs copied to locals first: the stores below then cannot alias them.
+  const double xa[3] = {at.x[a][0], at.x[a][1], at.x[a][2]};
+  const double d[3] = {at.x[b][0] - xa[0], at.x[b][1] - xa[1], at.x[b][2] - xa[2]};
+  const double wa[3] = {at.omega[a][0], at.omega[a][1], at.omega[a][2]};
+  const double wb[3] = {at.omega[b][0], at.omega[b][1], at.omega[b][2]};
+  const double dv[3] = {at.v[b][0] - at.v[a][0], at.v[b][1] - at.v[a][1], at.v[b][2] - at.v[a][2]};
+  const double ra_s = at.radius[a], rb_s = at.radius[b];
+  const double dt = at.dt;
+  const double l0 = hist[L0];
+  double fs[3] = {hist[FS], hist[FS + 1], hist[FS + 2]};
+  double mb[3] = {hist[MB], hist[MB + 1], hist[MB + 2]};
+  double mt = hist[MT];
+
+  const double len = norm3(d);
+  const double inv_len = 1.0 / len;
+  const double n[3] = {d[0] * inv_len, d[1] * inv_len, d[2] * inv_len};
+
+  // Potyondy & Cundall 2004, eq. 5: parallel-bond disc of radius lambda min(Ri,Rj),
+  // A = pi R^2, I = pi R^4 / 4, J = 2 I.
+  const double rbond = radius_multiplier_ * std::min(ra_s, rb_s);
+  const double area = kPi * rbond * rbond;
+  const double inertia = 0.25 * area * rbond * rbond;
+  const double polar = 2.0 * inertia;
+  const double inv_area = 1.0 / area;
+  const double inv_inertia = 4.0 * kPi * inv_area * inv_area;  // = 1 / (pi R^4 / 4)
+  // Stiffness per unit area from the bond modulus over the initial length,
+  // kn = E_b / L0, ks = kn / (kn/ks)  (Potyondy & Cundall 2004, sec. 2.2).
+  const double kn = modulus_ / l0;    // [Pa/m]
+  const double ks = kn * inv_ratio_;  // [Pa/m]
+
+  // Contact point on the line of centres (Ra : Rb split): a rigid rotation of
+  // the pair then gives no relative motion there (objective shear increment).
+  const double arm_a = len * ra_s / (ra_s + rb_s);
+  const double arm_b = len - arm_a;
+  const double ra_vec[3] = {arm_a * n[0], arm_a * n[1], arm_a * n[2]};
+  const double rb_vec[3] = {-arm_b * n[0], -arm_b * n[1], -arm_b * n[2]};
+
+  // Relative velocity of b's material point at the contact w.r.t. a's.
+  double wa_r[3], wb_r[3];
+  cross3(wa, ra_vec, wa_r);
+  cross3(wb, rb_vec, wb_r);
+  const double vrel[3] = {dv[0] + wb_r[0] - wa_r[0], dv[1] + wb_r[1] - wa_r[1],
+                          dv[2] + wb_r[2] - wa_r[2]};
+  const double vn = dot3(vrel, n);
+  const double vt[3] = {vrel[0] - vn * n[0], vrel[1] - vn * n[1], vrel[2] - vn * n[2]};
+
+  if (advance) {
+    // Carry the stored shear force and bending moment with the bond plane.
+    const double spin = 0.5 * (dot3(wa, n) + dot3(wb, n)) * dt;
+    rotate_onto_plane(fs, n, spin);
+    rotate_onto_plane(mb, n, spin);
+    // Potyondy & Cundall 2004, eq. 6: incremental shear force and moments.
+    const double wrel[3] = {wb[0] - wa[0], wb[1] - wa[1], wb[2] - wa[2]};
+    const double wn = dot3(wrel, n);
+    const double ksa_dt = ks * area * dt, kni_dt = kn * inertia * dt;
+    for (int k = 0; k < 3; ++k) {
+      fs[k] -= ksa_dt * vt[k];                  // dF^s = -k^s A dU^s
+      mb[k] -= kni_dt * (wrel[k] - wn * n[k]);  // dM^s = -k^n I dtheta^s
+    }
+    mt -= ks * polar * wn * dt;  // dM^n = -k^s J dtheta^n
+    for (int k = 0; k < 3; ++k) {
+      hist[FS + k] = fs[k];
+      hist[MB + k] = mb[k];
+    }
+    hist[MT] = mt;
+  }
+
+  // Normal force from the total stretch (tension > 0): exact elastic energy
+  // (the total form of P&C eq. 6's normal increment).
+  const double stretch = len - l0;
+  const double fn = kn * area * stretch;
+
+  // Potyondy & Cundall 2004, eq. 7: extreme stresses on the bond periphery;
+  // compressive normal force never counts as tension.
+  const double mb_sq = dot3(mb, mb), fs_sq = dot3(fs, fs);
+  const double mb_mag = std::sqrt(mb_sq);
+  const double fs_mag = std::sqrt(fs_sq);
+  out.sigma = std::max(fn, 0.0) * inv_area + mb_mag * rbond * inv_inertia;
+  out.tau = fs_mag * inv_area + std::fabs(mt) * rbond * 0.5 * inv_inertia;
+  // Mohr-Coulomb shear strength, compressive normal stress only (Potyondy 2015,
+  // linear parallel bond: tau_c = c - sigma tan(phi) with sigma < 0 compressive).
+  out.strength = cohesion_ + tan_friction_ * std::max(-fn, 0.0) * inv_area;
+  out.mode = 0;
+  if (out.sigma > tensile_strength_)
+    out.mode = 1;
+  else if (out.tau > out.strength)
+    out.mode = 2;
+  if (out.mode != 0) {
+    for (int k = 0; k < 3; ++k) out.centre[k] = xa[k] + ra_vec[k];
+    if (advance) return;  // breaks now: exerts no force from this step on
+  }
+
+  // Elastic energy: fn^2/(2 kn A) + |Fs|^2/(2 ks A) + |Mb|^2/(2 kn I) + Mt^2/(2 ks J).
+  const double inv_kn = l0 * inv_modulus_;
+  out.energy = 0.5 * fn * stretch + 0.5 * inv_kn *
+                                        (stiffness_ratio_ * fs_sq * inv_area + mb_sq * inv_inertia +
+                                         stiffness_ratio_ * mt * mt * 0.5 * inv_inertia);
+
+  // Force on b: spring part plus optional viscous part (fraction of critical
+  // damping of the two-body normal / shear oscillator; not part of the stress).
+  double fb[3];
+  for (int k = 0; k < 3; ++k) fb[k] = -fn * n[k] + fs[k];
+  if (damping_ > 0.0) {
+    const double ma = at.rmass[a], mbm = at.rmass[b];
+    const double mred = ma * mbm / (ma + mbm);
+    const double cn = 2.0 * damping_ * std::sqrt(mred * kn * area);
+    const double cs = cn * std::sqrt(inv_ratio_);
+    for (int k = 0; k < 3; ++k) fb[k] -= cn * vn * n[k] + cs * vt[k];
+  }
+  for (int k = 0; k < 3; ++k) out.fa[k] = -fb[k];
+
+  // Torques: force at the contact point plus the bond moments (on b: +M).
+  double tqa[3], tqb[3];
+  cross3(ra_vec, out.fa, tqa);
+  cross3(rb_vec, fb, tqb);
+  for (int k = 0; k < 3; ++k) {
+    const double m = mb[k] + mt * n[k];
+    out.ta[k] = tqa[k] - m;
+    out.tb[k] = tqb[k] + m;
+  }
+}
+
+// Loops over the bonds of owned atoms: advances (if advance), breaks, applies
+// forces, then does this step's single reduction of the global counters.
+void FixBondBreakable::compute_bonds(bool advance) {
+  double **f = atom->f, **torque = atom->torque;
+  int *tag = atom->tag;
+  const int nlocal = atom->nlocal;
+  const AtomArrays at{atom->x, atom->v, atom->omega, atom->radius, atom->rmass, update->dt};
+  const bool periodic = domain->xperiodic || domain->yperiodic || domain->zperiodic;
+
+  if (atom->nmax > nmax_) grow_arrays(atom->nmax);
+  events_.clear();
+  double local[4] = {0.0, 0.0, 0.0, 0.0};  // intact, new tension, new shear, energy
+  BondResult r;
+
+  for (int i = 0; i < nlocal; ++i) {
+    for (int k = nbond_[i] - 1; k >= 0; --k) {
+      double *slot = &bonds_[i][k * NCOL];
+      const int ptag = static_cast<int>(slot[PARTNER]);
+      int jloc = atom->map(ptag);
+      if (jloc >= 0 && tag[jloc] != ptag) jloc = -1;  // stale map entry
+      const bool partner_local = jloc >= 0 && jloc < nlocal;
+      const bool i_lower = tag[i] < ptag;
+      if (partner_local && !i_lower) continue;  // the partner's owner (this rank) handles it
+      const int jimg = (jloc < 0 || periodic) ? partner_index(i, ptag) : jloc;
+
+      const int a = i_lower ? i : jimg;
+      const int b = i_lower ? jimg : i;
+      evaluate_bond(at, a, b, slot, advance, r);
+
+      int jslot = -1;
+      if (partner_local) {
+        jslot = find_slot(jloc, tag[i]);
+        if (jslot < 0) {
+          std::string m = "fix bond/breakable: internal error, bond " + std::to_string(tag[i]) +
+                          "-" + std::to_string(ptag) + " stored on one end only";
+          fail_one(m);
+        }
+      }
+
+      if (advance && r.mode != 0) {
+        if (i_lower) {  // counted once: by the owner of the lower tag
+          local[r.mode] += 1.0;
+          const double ev[kEventCols] = {static_cast<double>(update->ntimestep),
+                                         update->get_cur_time(),
+                                         r.centre[0],
+                                         r.centre[1],
+                                         r.centre[2],
+                                         static_cast<double>(r.mode),
+                                         static_cast<double>(tag[i]),
+                                         static_cast<double>(ptag),
+                                         r.sigma,
+                                         r.tau};
+          events_.insert(events_.end(), ev, ev + kEventCols);
+        }
+        if (partner_local) remove_slot(jloc, jslot);
+        remove_slot(i, k);
+        continue;
+      }
+
+      // Apply this rank's share: both ends if the partner is owned here.
+      const double *fi = i_lower ? r.fa : nullptr;
+      double fneg[3] = {-r.fa[0], -r.fa[1], -r.fa[2]};
+      if (!i_lower) fi = fneg;
+      const double *ti = i_lower ? r.ta : r.tb;
+      for (int c = 0; c < 3; ++c) {
+        f[i][c] += fi[c];
+        torque[i][c] += ti[c];
+      }
+      if (partner_local) {
+        // i is the lower tag here: the partner is b.
+        for (int c = 0; c < 3; ++c) {
+          f[jloc][c] -= r.fa[c];
+          torque[jloc][c] += r.tb[c];
+        }
+        std::memcpy(&bonds_[jloc][jslot * NCOL + L0], &slot[L0], (NCOL - 1) * sizeof(double));
+      }
+      if (i_lower) {
+        local[0] += 1.0;
+        local[3] += r.energy;
+      }
+    }
+  }
+  for (int i = 0; i < nlocal; ++i) count_[i] = nbond_[i];
+  vector_atom = count_;
+
+  double global[4];
+  MPI_Allreduce(local, global, 4, MPI_DOUBLE, MPI_SUM, world);
+  intact_ = global[0];
+  broken_tension_ += global[1];
+  broken_shear_ += global[2];
+  energy_ = global[3];
+  if (global[1] + global[2] > 0.0 && !break_log_path_.empty()) write_break_events();
+}
+
+// Gathers this step's break events to rank 0 and appends them to the log.
+void FixBondBreakable::write_break_events() {
+  int n = static_cast<int>(events_.size());
+  std::vector<int> counts(comm->nprocs), displs(comm->nprocs, 0);
+  MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
+  std::vector<double> all;
+  if (comm->me == 0) {
+    int tot = 0;
+    for (int p = 0; p < comm->nprocs; ++p) {
+      displs[p] = tot;
+      tot += counts[p];
+    }
+    all.resize(tot);
+  }
+  MPI_Gatherv(events_.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE,
+              0, world);
+  if (comm->me != 0 || !break_log_) return;
+  for (size_t e = 0; e + kEventCols <= all.size(); e += kEventCols) {
+    const double *ev = &all[e];
+    fprintf(break_log_, "%.0f %.10g %.10g %.10g %.10g %s %.0f %.0f %.8g %.8g\n", ev[0], ev[1],
+            ev[2], ev[3], ev[4], ev[5] == 1.0 ? "tension" : "shear", ev[6], ev[7], ev[8], ev[9]);
+  }
+  fflush(break_log_);
+}
+
+// Writes all intact bonds (tag_i < tag_j) to the dump file via FILE.tmp + rename.
+void FixBondBreakable::write_bond_dump() {
+  std::vector<int> mine;
+  for (int i = 0; i < atom->nlocal; ++i)
+    for (int k = 0; k < nbond_[i]; ++k) {
+      const int p = static_cast<int>(bonds_[i][k * NCOL + PARTNER]);
+      if (atom->tag[i] < p) {
+        mine.push_back(atom->tag[i]);
+        mine.push_back(p);
+      }
+    }
+  int n = static_cast<int>(mine.size());
+  std::vector<int> counts(comm->nprocs), displs(comm->nprocs, 0);
+  MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
+  std::vector<int> all;
+  if (comm->me == 0) {
+    int tot = 0;
+    for (int p = 0; p < comm->nprocs; ++p) {
+      displs[p] = tot;
+      tot += counts[p];
+    }
+    all.resize(tot);
+  }
+  MPI_Gatherv(mine.data(), n, MPI_INT, all.data(), counts.data(), displs.data(), MPI_INT, 0, world);
+  if (comm->me != 0) return;
+
+  std::vector<std::pair<int, int>> pairs;
+  for (size_t e = 0; e + 1 < all.size(); e += 2) pairs.emplace_back(all[e], all[e + 1]);
+  std::sort(pairs.begin(), pairs.end());
+  std::string path = dump_bonds_path_;
+  const size_t star = path.find('*');
+  if (star != std::string::npos) path.replace(star, 1, std::to_string(update->ntimestep));
+  const std::string tmp = path + ".tmp";
+  FILE *fp = fopen(tmp.c_str(), "w");
+  if (!fp) {
+    std::string m = "fix bond/breakable: cannot write dump_bonds file '" + tmp + "'";
+    fail_one(m);
+  }
+  fprintf(fp, "# fix bond/breakable intact bonds\n# step " BIGINT_FORMAT "\n", update->ntimestep);
+  fprintf(fp, "# bonds %zu\n# columns: tag_i tag_j\n", pairs.size());
+  for (const auto &p : pairs) fprintf(fp, "%d %d\n", p.first, p.second);
+  fclose(fp);
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::string m = "fix bond/breakable: cannot rename '" + tmp + "' to '" + path + "'";
+    fail_one(m);
+  }
+}
+
+// Critical time step of the bond springs from a Gershgorin bound on the
+// largest eigenfrequency of the mass-weighted stiffness (rows of atom i: the
+// diagonal plus the partner terms, and the translation-rotation coupling
+// ks A r / sqrt(m I) of the shear spring); velocity Verlet is stable for
+// omega dt < 2. Printed; warns if the deck's dt exceeds it.
+void FixBondBreakable::estimate_time_step() {
+  double *radius = atom->radius, *rmass = atom->rmass;
+  double local[2] = {1e300, 1e300};
+  for (int i = 0; i < atom->nlocal; ++i) {
+    if (nbond_[i] == 0) continue;
+    const double irot = 0.4 * rmass[i] * radius[i] * radius[i];
+    const double couple_norm = 1.0 / std::sqrt(rmass[i] * irot);
+    double kn_sum = 0.0, ks_sum = 0.0, rot_sum = 0.0, couple_sum = 0.0;
+    for (int k = 0; k < nbond_[i]; ++k) {
+      const int j = partner_index(i, static_cast<int>(bonds_[i][k * NCOL + PARTNER]));
+      const double l0 = bonds_[i][k * NCOL + L0];
+      const double rb = radius_multiplier_ * std::min(radius[i], radius[j]);
+      const double area = kPi * rb * rb, inertia = 0.25 * area * rb * rb;
+      const double kn = modulus_ / l0, ks = kn / stiffness_ratio_;
+      const double arm = l0 * radius[i] / (radius[i] + radius[j]);
+      kn_sum += kn * area;
+      ks_sum += ks * area;
+      rot_sum += ks * area * arm * arm + kn * inertia;
+      couple_sum += ks * area * arm;
+    }
+    const double w2_normal = 2.0 * kn_sum / rmass[i];
+    const double w2_shear = 2.0 * ks_sum / rmass[i] + 2.0 * couple_sum * couple_norm;
+    const double w2_rot = 2.0 * rot_sum / irot + 2.0 * couple_sum * couple_norm;
+    local[0] = std::min(local[0], 2.0 / std::sqrt(std::max(w2_normal, w2_shear)));
+    local[1] = std::min(local[1], 2.0 / std::sqrt(w2_rot));
+  }
+  double global[2];
+  MPI_Allreduce(local, global, 2, MPI_DOUBLE, MPI_MIN, world);
+  if (global[0] >= 1e300) {
+    dt_crit_ = 0.0;
+    return;
+  }
+  dt_crit_ = std::min(global[0], global[1]);
+  char line[256];
+  snprintf(line, sizeof(line),
+           "fix bond/breakable: critical time step of bond springs %.4g s (translational %.4g s, "
+           "rotational %.4g s); time step %.4g s",
+           dt_crit_, global[0], global[1], update->dt);
+  message(line);
+  if (update->dt > dt_crit_ && comm->me == 0) {
+    snprintf(line, sizeof(line),
+             "fix bond/breakable: time step %g s exceeds the bond critical time step %g s",
+             update->dt, dt_crit_);
+    error->warning(FLERR, line);
+  }
+}
+
+/* ---------------------------------------------------------------------- */
+
+// Global outputs: 1 intact bonds, 2 broken, 3 broken by tension, 4 broken by
+// shear, 5 bond elastic energy [J], 6 critical time step [s]. Cached values.
+double FixBondBreakable::compute_vector(int n) {
+  switch (n) {
+    case 0:
+      return intact_;
+    case 1:
+      return broken_tension_ + broken_shear_;
+    case 2:
+      return broken_tension_;
+    case 3:
+      return broken_shear_;
+    case 4:
+      return energy_;
+    case 5:
+      return dt_crit_;
+    default:
+      return 0.0;
+  }
+}
+
+// Global restart state: all parameters and the cumulative counters.
+void FixBondBreakable::write_restart(FILE *fp) {
+  const double list[] = {radius_multiplier_,
+                         modulus_,
+                         stiffness_ratio_,
+                         tensile_strength_,
+                         cohesion_,
+                         friction_angle_,
+                         damping_,
+                         gap_,
+                         static_cast<double>(max_bonds_),
+                         static_cast<double>(bonds_created_),
+                         broken_tension_,
+                         broken_shear_,
+                         lmax_};
+  const int n = sizeof(list) / sizeof(list[0]);
+  if (comm->me == 0) {
+    int size = n * sizeof(double);
+    fwrite(&size, sizeof(int), 1, fp);
+    fwrite(list, sizeof(double), n, fp);
+  }
+}
+
+// Restores parameters and counters written by write_restart; keywords given
+// again in the deck must agree (bonds created with other parameters would lie).
+void FixBondBreakable::restart(char *buf) {
+  const double *list = reinterpret_cast<double *>(buf);
+  const char *names[] = {"radius_multiplier", "modulus",  "stiffness_ratio",
+                         "tensile_strength",  "cohesion", "friction_angle",
+                         "damping",           "gap",      "max_bonds"};
+  double *mine[] = {&radius_multiplier_, &modulus_,        &stiffness_ratio_, &tensile_strength_,
+                    &cohesion_,          &friction_angle_, &damping_,         &gap_};
+  for (int k = 0; k < 8; ++k)
+    if (*mine[k] != list[k] && comm->me == 0) {
+      std::string m = std::string("fix bond/breakable: ") + names[k] + " " + fmt_num(*mine[k]) +
+                      " differs from the restart file (" + fmt_num(list[k]) +
+                      "); using the deck's value";
+      error->warning(FLERR, m.c_str());
+    }
+  if (static_cast<int>(list[8]) > max_bonds_) {
+    std::string m = "fix bond/breakable: max_bonds " + std::to_string(max_bonds_) +
+                    " is smaller than in the restart file (" + fmt_num(list[8]) + ")";
+    error->all(FLERR, m.c_str());
+  }
+  bonds_created_ = static_cast<int>(list[9]);
+  broken_tension_ = list[10];
+  broken_shear_ = list[11];
+  lmax_ = list[12];
+}
+
+// Grows per-atom storage to nmax atoms.
+void FixBondBreakable::grow_arrays(int nmax) {
+  memory->grow(nbond_, nmax, "bond/breakable:nbond");
+  memory->grow(bonds_, nmax, max_bonds_ * NCOL, "bond/breakable:bonds");
+  memory->grow(count_, nmax, "bond/breakable:count");
+  for (int i = nmax_; i < nmax; ++i) {
+    nbond_[i] = 0;
+    count_[i] = 0.0;
+  }
+  nmax_ = nmax;
+  vector_atom = count_;
+}
+
+// Copies atom i's bonds to slot j (atom sorting, deletion).
+void FixBondBreakable::copy_arrays(int i, int j, int /*delflag*/) {
+  nbond_[j] = nbond_[i];
+  count_[j] = count_[i];
+  std::memcpy(bonds_[j], bonds_[i], nbond_[i] * NCOL * sizeof(double));
+}
+
+// A newly created atom has no bonds.
+void FixBondBreakable::set_arrays(int i) {
+  if (i >= nmax_) grow_arrays(atom->nmax);
+  nbond_[i] = 0;
+  count_[i] = 0.0;
+}
+
+// Columns: nbond, then nbond x (PARTNER L0 FS[3] MB[3] MT).
+int FixBondBreakable::pack_exchange(int i, double *buf) {
+  buf[0] = nbond_[i];
+  std::memcpy(&buf[1], bonds_[i], nbond_[i] * NCOL * sizeof(double));
+  return 1 + nbond_[i] * NCOL;
+}
+
+// Same columns as pack_exchange.
+int FixBondBreakable::unpack_exchange(int nlocal, double *buf) {
+  if (nlocal >= nmax_) grow_arrays(atom->nmax);
+  nbond_[nlocal] = static_cast<int>(buf[0]);
+  std::memcpy(bonds_[nlocal], &buf[1], nbond_[nlocal] * NCOL * sizeof(double));
+  count_[nlocal] = nbond_[nlocal];
+  return 1 + nbond_[nlocal] * NCOL;
+}
+
+// Restart columns: size, nbond, then nbond x (PARTNER L0 FS[3] MB[3] MT).
+int FixBondBreakable::pack_restart(int i, double *buf) {
+  buf[0] = 2 + nbond_[i] * NCOL;
+  buf[1] = nbond_[i];
+  std::memcpy(&buf[2], bonds_[i], nbond_[i] * NCOL * sizeof(double));
+  return 2 + nbond_[i] * NCOL;
+}
+
+// Reads this fix's columns of atom nlocal from atom->extra (same order).
+void FixBondBreakable::unpack_restart(int nlocal, int nth) {
+  double **extra = atom->extra;
+  int m = 0;
+  for (int i = 0; i < nth; ++i) m += static_cast<int>(extra[nlocal][m]);
+  m++;
+  const int nb = static_cast<int>(extra[nlocal][m++]);
+  if (nb > max_bonds_) {
+    std::string m2 = "fix bond/breakable: restart atom has " + std::to_string(nb) +
+                     " bonds, more than max_bonds " + std::to_string(max_bonds_);
+    fail_one(m2);
+  }
+  nbond_[nlocal] = nb;
+  std::memcpy(bonds_[nlocal], &extra[nlocal][m], nb * NCOL * sizeof(double));
+  count_[nlocal] = nb;
+}
+
+// Restart size of atom nlocal.
+int FixBondBreakable::size_restart(int nlocal) { return 2 + nbond_[nlocal] * NCOL; }
+
+// Largest restart size of any atom.
+int FixBondBreakable::maxsize_restart() { return 2 + max_bonds_ * NCOL; }
+
+// Bytes of per-atom storage.
+double FixBondBreakable::memory_usage() {
+  return static_cast<double>(nmax_) * (sizeof(int) + sizeof(double) * (1 + max_bonds_ * NCOL));
+}

@@ -1,0 +1,114 @@
+// fix bond/breakable: breakable parallel bonds between granular spheres
+// (Potyondy & Cundall 2004) for LIGGGHTS 3.8. See docs/styles/fix_bond_breakable.md.
+//
+// Bonds live with the atoms: every atom stores, for each of its intact bonds,
+// the partner's tag and the bond's history (initial length, shear force,
+// bending moment, twisting moment). The history is mirrored on both atoms and
+// always expressed in the canonical direction lower tag -> higher tag, so that
+// two ranks that each own one end compute bitwise the same bond.
+#ifndef MILL_FIX_BOND_BREAKABLE_H
+#define MILL_FIX_BOND_BREAKABLE_H
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "fix.h"
+
+namespace LAMMPS_NS {
+
+class FixBondBreakable : public Fix {
+ public:
+  FixBondBreakable(class LAMMPS *lmp, int narg, char **arg);
+  ~FixBondBreakable() override;
+
+  static const char *style_name() { return "bond/breakable"; }
+
+  int setmask() override;
+  void init() override;
+  void setup(int vflag) override;
+  void post_force(int vflag) override;
+  void end_of_step() override;
+  void post_run() override;
+
+  double compute_vector(int n) override;
+  double extend_cut_ghost() override;
+
+  void write_restart(FILE *fp) override;
+  void restart(char *buf) override;
+
+  void grow_arrays(int nmax) override;
+  void copy_arrays(int i, int j, int delflag) override;
+  void set_arrays(int i) override;
+  int pack_exchange(int i, double *buf) override;
+  int unpack_exchange(int nlocal, double *buf) override;
+  int pack_restart(int i, double *buf) override;
+  void unpack_restart(int nlocal, int nth) override;
+  int size_restart(int nlocal) override;
+  int maxsize_restart() override;
+  double memory_usage() override;
+
+  // Per-bond columns stored per atom and slot: partner tag, initial length L0,
+  // shear force (3), bending moment (3), twisting moment (1). Canonical frame.
+  enum Column { PARTNER = 0, L0, FS, MB = FS + 3, MT = MB + 3, NCOL };
+
+ private:
+  // Parameters (SI units, see the doc page).
+  double radius_multiplier_ = 1.0;  // lambda, bond radius = lambda min(Ri,Rj)  [-]
+  double modulus_ = 0.0;            // E_b, bond modulus                          [Pa]
+  double stiffness_ratio_ = 0.0;    // kn/ks                                     [-]
+  double tensile_strength_ = 0.0;   // sigma_c                                   [Pa]
+  double cohesion_ = 0.0;           // c                                         [Pa]
+  double friction_angle_ = 0.0;     // phi                                       [deg]
+  double damping_ = 0.0;            // fraction of critical damping              [-]
+  double gap_ = 0.1;                // bonding tolerance, x min radius           [-]
+  int max_bonds_ = 16;              // slots per atom
+  std::string break_log_path_;
+  std::string dump_bonds_path_;
+  int dump_every_ = 0;
+
+  // Run state (global, written to restart).
+  int bonds_created_ = 0;
+  double broken_tension_ = 0.0;
+  double broken_shear_ = 0.0;
+
+  // Cached per-step reductions (read by compute_vector).
+  double intact_ = 0.0;
+  double energy_ = 0.0;
+  double dt_crit_ = 0.0;
+
+  // Per-atom storage.
+  int nmax_ = 0;
+  int *nbond_ = nullptr;      // intact bonds of each atom
+  double **bonds_ = nullptr;  // [atom][slot * NCOL + column]
+  double *count_ = nullptr;   // intact-bond count exposed as vector_atom
+
+  double tan_friction_ = 0.0;   // tan(phi), set in init()
+  double inv_ratio_ = 0.0;      // ks/kn, set in init()
+  double inv_modulus_ = 0.0;    // 1/E_b, set in init()
+  double rmax_ = 0.0;           // largest radius in the group
+  double rmin_ = 0.0;           // smallest radius in the group
+  double lmax_ = 0.0;           // longest bond length (initial)
+  FILE *break_log_ = nullptr;   // rank 0 only
+  std::vector<double> events_;  // break events of this step (local)
+
+  struct BondResult;
+  struct AtomArrays;
+  void parse_args(int narg, char **arg);
+  void create_bonds();
+  void compute_bonds(bool advance);
+  void evaluate_bond(const AtomArrays &at, int a, int b, double *hist, bool advance,
+                     BondResult &out) const;
+  void remove_slot(int i, int slot);
+  int find_slot(int i, int partner_tag) const;
+  int partner_index(int i, int partner_tag) const;
+  void estimate_time_step();
+  void write_bond_dump();
+  void write_break_events();
+  void message(const std::string &text) const;
+  [[noreturn]] void fail_one(const std::string &text) const;
+};
+
+}  // namespace LAMMPS_NS
+
+#endif

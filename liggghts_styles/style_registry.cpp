@@ -1,0 +1,48 @@
+#include "style_registry.h"
+
+#include <map>
+
+#include "fix_bond_breakable.h"
+#include "lammps.h"
+#include "modify.h"
+
+namespace mill {
+namespace {
+
+// Same signature as LIGGGHTS's private Modify::FixCreator.
+using FixCreator = LAMMPS_NS::Fix *(*)(LAMMPS_NS::LAMMPS *, int, char **);
+using FixMap = std::map<std::string, FixCreator>;
+
+// Access to the private member Modify::fix_map without patching LIGGGHTS:
+// access checking does not apply to the template arguments of an explicit
+// instantiation ([temp.spec]/6 in C++17), so the instantiation below may name
+// &Modify::fix_map and hand the pointer-to-member out through a friend.
+struct FixMapTag {
+  using type = FixMap *LAMMPS_NS::Modify::*;
+  friend type member_of(FixMapTag);
+};
+template <typename Tag, typename Tag::type Member>
+struct Grant {
+  friend typename Tag::type member_of(Tag) { return Member; }
+};
+template struct Grant<FixMapTag, &LAMMPS_NS::Modify::fix_map>;
+
+// Creates one fix of style T; stored in the registry.
+template <typename T>
+LAMMPS_NS::Fix *create_fix(LAMMPS_NS::LAMMPS *lmp, int narg, char **arg) {
+  return new T(lmp, narg, arg);
+}
+
+}  // namespace
+
+// Adds the project's fix styles to the registry of lmp (before the deck runs).
+std::vector<std::string> register_mill_styles(LAMMPS_NS::LAMMPS *lmp) {
+  FixMap *fix_map = lmp->modify->*member_of(FixMapTag{});
+  std::vector<std::string> names;
+  using LAMMPS_NS::FixBondBreakable;
+  (*fix_map)[FixBondBreakable::style_name()] = &create_fix<FixBondBreakable>;
+  names.emplace_back(LAMMPS_NS::FixBondBreakable::style_name());
+  return names;
+}
+
+}  // namespace mill

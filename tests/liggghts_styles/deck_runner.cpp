@@ -1,0 +1,152 @@
+#include "deck_runner.h"
+
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+
+namespace mill_test {
+
+namespace {
+
+// Run directories made by this process.
+std::vector<std::string> &run_dirs() {
+  static std::vector<std::string> dirs;
+  return dirs;
+}
+
+// Removes the run directories after a fully passing test program; keeps them
+// for inspection after a failure or when MILL_KEEP_TEST_DIRS is set.
+class RunDirCleanup : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    if (std::getenv("MILL_KEEP_TEST_DIRS") || !::testing::UnitTest::GetInstance()->Passed()) return;
+    std::error_code ec;
+    for (const auto &d : run_dirs()) std::filesystem::remove_all(d, ec);
+  }
+};
+
+const auto *const kCleanup = ::testing::AddGlobalTestEnvironment(new RunDirCleanup);
+
+}  // namespace
+
+// Makes a unique run directory under /tmp.
+std::string make_run_dir(const std::string &name) {
+  std::string templ = "/tmp/styles_" + name + "_XXXXXX";
+  std::vector<char> buf(templ.begin(), templ.end());
+  buf.push_back('\0');
+  if (!mkdtemp(buf.data())) throw std::runtime_error("mkdtemp failed for " + templ);
+  run_dirs().emplace_back(buf.data());
+  return std::string(buf.data());
+}
+
+// Runs the deck; mpirun gets --oversubscribe (and --allow-run-as-root as root).
+RunResult run_deck(const std::string &dir, const std::string &deck, int nprocs,
+                   const std::string &exe, const std::string &extra_args) {
+  {
+    std::ofstream out(dir + "/in.deck");
+    out << deck;
+  }
+  std::string cmd = "cd '" + dir + "' && ";
+  if (nprocs > 1) {
+    cmd += std::string(MILL_MPIEXEC) + " -np " + std::to_string(nprocs) + " --oversubscribe ";
+    if (geteuid() == 0) cmd += "--allow-run-as-root ";
+  }
+  cmd += (exe.empty() ? std::string(MILL_LIGGGHTS_EXE) : exe) + " -in in.deck -log log.lammps " +
+         extra_args + " > screen.txt 2>&1";
+  RunResult r;
+  const int status = std::system(cmd.c_str());
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(dir + "/screen.txt");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  r.screen = ss.str();
+  return r;
+}
+
+// Reads numeric rows, skipping comments and lines that do not parse.
+std::vector<std::vector<double>> read_table(const std::string &path) {
+  std::vector<std::vector<double>> rows;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ls(line);
+    std::vector<double> row;
+    std::string tok;
+    bool ok = true;
+    while (ls >> tok) {
+      char *end = nullptr;
+      const double v = std::strtod(tok.c_str(), &end);
+      if (*end != '\0') {
+        ok = false;
+        break;
+      }
+      row.push_back(v);
+    }
+    if (ok && !row.empty()) rows.push_back(row);
+  }
+  return rows;
+}
+
+// Reads the `tag_i tag_j` lines of a dump_bonds file.
+std::vector<std::pair<int, int>> read_bonds(const std::string &path) {
+  std::vector<std::pair<int, int>> bonds;
+  for (const auto &row : read_table(path))
+    if (row.size() == 2) bonds.emplace_back(static_cast<int>(row[0]), static_cast<int>(row[1]));
+  return bonds;
+}
+
+// Union-find over atoms 1..natoms.
+int count_fragments(int natoms, const std::vector<std::pair<int, int>> &bonds) {
+  std::vector<int> parent(natoms + 1);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&parent](int a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  int fragments = natoms;
+  for (const auto &b : bonds) {
+    const int ra = find(b.first), rb = find(b.second);
+    if (ra != rb) {
+      parent[ra] = rb;
+      --fragments;
+    }
+  }
+  return fragments;
+}
+
+// Deck head shared by all tests.
+std::string deck_head(double half_box, double youngs, const std::string &boundary) {
+  std::ostringstream d;
+  d.precision(17);
+  d << "units si\n"
+    << "atom_style sphere\n"
+    << "atom_modify map array\n"
+    << "boundary " << boundary << "\n"
+    << "newton off\n"
+    << "communicate single vel yes\n"
+    << "region box block " << -half_box << " " << half_box << " " << -half_box << " " << half_box
+    << " " << -half_box << " " << half_box << " units box\n"
+    << "create_box 1 box\n"
+    << "neighbor 0.0002 bin\n"
+    << "neigh_modify delay 0\n"
+    << "hard_particles yes\n"
+    << "fix m1 all property/global youngsModulus peratomtype " << youngs << "\n"
+    << "fix m2 all property/global poissonsRatio peratomtype 0.25\n"
+    << "fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\n"
+    << "fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n"
+    << "pair_style gran model hertz tangential history\n"
+    << "pair_coeff * *\n";
+  return d.str();
+}
+
+}  // namespace mill_test
