@@ -114,7 +114,7 @@ Plan BreakageStage::plan(const StageContext& ctx) const {
       case_keys(d, {"lump.", "breakage.duration_after_contact", "breakage.timestep", "breakage.quiet_time"});
   base["ore"] = ore_keys(ctx.cfg.ore);
   base["bond"] = bond_json(bond_params_for(ctx.cfg, ctx.run_dir));
-  base["deck_version"] = 2;
+  base["deck_version"] = 3;
   for (double v : d.reals("breakage.velocities"))
     for (double a : d.reals("breakage.angles"))
       for (long r = 0; r < d.integer("breakage.repeats"); ++r) {
@@ -163,6 +163,7 @@ std::string run_impact(StageContext& ctx, double velocity, double angle, int rep
               {"quiet_time", num(d.real("breakage.quiet_time"))},
               {"dt", num(d.real("breakage.timestep"))},
               {"skin", num(0.3 * lump.mean_radius)},
+              {"binsize", num(4.0 * lump.mean_radius)},
               {"dump_interval", num(d.real("breakage.dump_interval"))},
               {"bond_gap", num(d.real("lump.bond_gap"))},
               {"max_bonds", std::to_string(d.integer("lump.max_bonds"))}};
