@@ -112,7 +112,7 @@ Schema make_case_schema() {
       range(key("lump.radius_spread", T::Real, "", "0.25", "Element radii uniform in (1 +- spread) x mean"), 0, false, 1, true),
       at_least(key("lump.n_packings", T::Int, "", "1", "Distinct random packings (lumps) for statistics"), 1),
       at_least(key("lump.seed", T::Int, "", "1001", "Seed of the first packing"), 1),
-      at_least(key("lump.bond_gap", T::Real, "", "0.2", "Bond pairs whose gap is below this x min(Ri, Rj) (0.2: coordination ~6)"), 0),
+      at_least(key("lump.bond_gap", T::Real, "", "0.15", "Bond pairs whose gap is below this x min(Ri, Rj) (0.15: coordination ~6.3 at 3344 elements)"), 0),
       at_least(key("lump.max_bonds", T::Int, "", "16", "Cap of bonds per element"), 1),
       positive(key("lump.bond_radius_multiplier", T::Real, "", "1.0", "Bond disc radius = multiplier x min(Ri, Rj)")),
 
@@ -141,6 +141,8 @@ Schema make_case_schema() {
       at_least(key("calibrate.max_iterations", T::Int, "", "8", "Calibration iterations cap"), 1),
       positive(key("calibrate.tolerance", T::Real, "", "0.1", "Relative tolerance on E, UCS and tensile strength")),
       at_least(key("calibrate.seed", T::Int, "", "2002", "Seed of the specimen packing"), 1),
+      key("calibrate.rate_check", T::Bool, "", "true",
+          "After the fit, repeat the UCS test at half the strain rate (quasi-static check)"),
 
       // --- resources ---
       at_least(key("resources.np", T::Int, "", "1", "MPI ranks per engine run (--np overrides)"), 1),
