@@ -6,7 +6,7 @@
 
 #include <cstdlib>
 #include <fstream>
-#include <regex>
+#include <sstream>
 
 #include "progress.h"
 
@@ -49,19 +49,22 @@ Result run_deck(Runner& runner, const DeckRun& run, Progress& progress, const st
   // Progress: the deck prints "nsteps N"; thermo lines start with the step.
   auto poll = [&](const fs::path& log) {
     std::ifstream in(log);
-    std::string line, last_step;
-    long total = 0;
-    static const std::regex nsteps_re("nsteps ([0-9]+)");
-    static const std::regex step_re("^\\s+([0-9]+)\\s+[-0-9.e+]+");
-    std::smatch m;
+    std::string line;
+    long total = 0, step = -1;
     while (std::getline(in, line)) {
-      if (std::regex_search(line, m, nsteps_re)) total = std::stol(m[1]);
-      else if (std::regex_search(line, m, step_re)) last_step = m[1];
+      const size_t k = line.find("nsteps ");
+      if (k != std::string::npos) {
+        total = std::atol(line.c_str() + k + 7);
+        continue;
+      }
+      // Thermo lines: leading spaces, the step, then a number (time).
+      std::istringstream ls(line);
+      long s = 0;
+      double t = 0;
+      if (!line.empty() && line[0] == ' ' && (ls >> s >> t)) step = s;
     }
-    if (total > 0 && !last_step.empty()) {
-      const long s = std::stol(last_step);
-      progress.job_step(label, fmt::format("step {}/{}", s, total), static_cast<double>(s) / total);
-    }
+    if (total > 0 && step >= 0)
+      progress.job_step(label, fmt::format("step {}/{}", step, total), static_cast<double>(step) / total);
   };
   return runner.run(deck_command(run), poll);
 }
