@@ -3,6 +3,8 @@
 #include <map>
 
 #include "fix_bond_breakable.h"
+#include "fix_fluid_drag.h"
+#include "fix_impact_recorder.h"
 #include "lammps.h"
 #include "modify.h"
 
@@ -42,6 +44,11 @@ std::vector<std::string> register_mill_styles(LAMMPS_NS::LAMMPS *lmp) {
   using LAMMPS_NS::FixBondBreakable;
   (*fix_map)[FixBondBreakable::style_name()] = &create_fix<FixBondBreakable>;
   names.emplace_back(LAMMPS_NS::FixBondBreakable::style_name());
+  (*fix_map)[LAMMPS_NS::FixFluidDrag::style_name()] = &create_fix<LAMMPS_NS::FixFluidDrag>;
+  names.emplace_back(LAMMPS_NS::FixFluidDrag::style_name());
+  (*fix_map)[LAMMPS_NS::FixImpactRecorder::style_name()] =
+      &create_fix<LAMMPS_NS::FixImpactRecorder>;
+  names.emplace_back(LAMMPS_NS::FixImpactRecorder::style_name());
   return names;
 }
 

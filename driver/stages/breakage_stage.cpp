@@ -11,16 +11,20 @@
 #include <vtkPolyData.h>
 #include <vtkXMLPolyDataWriter.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
 #include <random>
+#include <sstream>
 #include <unordered_map>
 
 #include "engine/liggghts.h"
 #include "jobs/job_store.h"
 #include "postprocess/breakage_results.h"
 #include "postprocess/distributions.h"
+#include "postprocess/impact_conditions.h"
+#include "postprocess/impact_stats.h"
 #include "postprocess/lammps_dump.h"
 #include "progress.h"
 #include "stages/lump_builder.h"
@@ -106,18 +110,47 @@ long read_long(const fs::path& f) {
 Plan BreakageStage::plan(const StageContext& ctx) const {
   Plan p;
   const auto& d = ctx.cfg.doc;
-  if (d.str("breakage.conditions") == "transport") {
-    p.note = "impact conditions come from transport/ (binned flywheel impacts); not implemented yet (issue 8)";
-    return p;
-  }
   nlohmann::json base =
       case_keys(d, {"lump.", "breakage.duration_after_contact", "breakage.timestep", "breakage.quiet_time"});
   base["ore"] = ore_keys(ctx.cfg.ore);
   base["bond"] = bond_json(bond_params_for(ctx.cfg, ctx.run_dir));
   base["deck_version"] = 3;
+  const long repeats = d.integer("breakage.repeats");
+  if (d.str("breakage.conditions") == "transport") {
+    // Conditions from stage 1: flywheel (and wall) impacts binned by normal speed.
+    std::vector<std::string> surfaces = {"flywheel"};
+    if (d.boolean("breakage.include_wall_impacts")) surfaces.push_back("housing");
+    for (double rpm : d.reals("rotor.rpm")) {
+      const fs::path f = ctx.run_dir / "transport" / rpm_label(rpm) / "impacts.csv";
+      if (!fs::exists(f)) {
+        p.note += (p.note.empty() ? "" : "; ") + fmt::format("waits for {} (orchestrate --stage transport)", f.string());
+        continue;
+      }
+      const auto conds = post::BinImpacts(post::ReadImpactsCsv(f.string()), surfaces,
+                                          static_cast<int>(d.integer("breakage.velocity_bins")));
+      for (const auto& c : conds)
+        for (long r = 0; r < repeats; ++r) {
+          const double v = std::round(c.velocity_m_s * 10) / 10;
+          const double a = std::clamp(std::round(c.angle_deg * 10) / 10, 1.0, 90.0);
+          nlohmann::json in = base;
+          in["velocity"] = v;
+          in["angle"] = a;
+          in["repeat"] = r;
+          in["rpm"] = rpm;
+          in["bin"] = c.bin;
+          in["weight"] = c.weight;
+          p.jobs.push_back({fmt::format("{}_b{}_{}", rpm_label(rpm), c.bin, impact_label(v, a, static_cast<int>(r))), in,
+                            fmt::format("{} bin {} ({:.0f}% of impacts, normal {:.1f}-{:.1f} m/s): {:g} m/s at {:g} deg, "
+                                        "repeat {}",
+                                        rpm_label(rpm), c.bin, 100 * c.weight, c.normal_low_m_s, c.normal_high_m_s, v, a,
+                                        r)});
+        }
+    }
+    return p;
+  }
   for (double v : d.reals("breakage.velocities"))
     for (double a : d.reals("breakage.angles"))
-      for (long r = 0; r < d.integer("breakage.repeats"); ++r) {
+      for (long r = 0; r < repeats; ++r) {
         nlohmann::json in = base;
         in["velocity"] = v;
         in["angle"] = a;
@@ -302,7 +335,74 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& jobs
   c.log = dir / "plots.log";
   c.job = "breakage/plots";
   ctx.runner.run(c);
+  if (ctx.cfg.doc.str("breakage.conditions") == "transport") write_mill_product(ctx, jobs);
   ctx.progress.info(fmt::format("[breakage] results: {}/summary.csv, fractions.csv, breakage.h5, plots/*.png", dir.string()));
+}
+
+void BreakageStage::write_mill_product(StageContext& ctx, const std::vector<JobSpec>& jobs) {
+  // Per rotor speed: average each bin over its repeats, weight bins by their
+  // share of impacts (postprocess/impact_conditions.h).
+  const fs::path dir = ctx.stage_dir;
+  const jobs::JobStore store(dir);
+  const auto edges = ctx.cfg.doc.reals("breakage.size_fraction_edges");
+  struct Acc {
+    post::ConditionBreakage c;
+    int n = 0;
+  };
+  std::map<double, std::map<int, Acc>> by_rpm;
+  for (const auto& j : jobs) {
+    const fs::path jd = store.job_dir(j.label);
+    const auto rows = post::ReadSummaryCsv((jd / "summary.csv").string());
+    if (rows.empty()) throw std::runtime_error((jd / "summary.csv").string() + ": no row");
+    std::vector<double> frac(edges.size() - 1, 0.0);
+    std::ifstream in(jd / "fractions.csv");
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+      std::vector<std::string> cells;
+      std::stringstream ss(line);
+      for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+      if (cells.size() < 7) continue;
+      const size_t k = std::stoul(cells[3]);
+      if (k < frac.size()) frac[k] = std::stod(cells[6]);
+    }
+    Acc& a = by_rpm[j.inputs.at("rpm").get<double>()][j.inputs.at("bin").get<int>()];
+    a.c.weight = j.inputs.at("weight").get<double>();
+    if (a.c.fraction_mass.empty()) a.c.fraction_mass.assign(frac.size(), 0.0);
+    for (size_t k = 0; k < frac.size(); ++k) a.c.fraction_mass[k] += frac[k];
+    a.c.single_mass_fraction += rows[0].single_mass_fraction;
+    a.c.largest_mass_fraction += rows[0].largest_mass_fraction;
+    a.c.t10_percent += rows[0].t10_percent;
+    ++a.n;
+  }
+  nlohmann::json out = nlohmann::json::array();
+  std::string csv = "rpm,fraction_index,d_low_rel,d_high_rel,mass_fraction\n";
+  for (auto& [rpm, bins] : by_rpm) {
+    std::vector<post::ConditionBreakage> conds;
+    for (auto& [bin, a] : bins) {
+      for (auto& f : a.c.fraction_mass) f /= a.n;
+      a.c.single_mass_fraction /= a.n;
+      a.c.largest_mass_fraction /= a.n;
+      a.c.t10_percent /= a.n;
+      conds.push_back(a.c);
+    }
+    const auto prod = post::CombineProduct(conds);
+    for (size_t k = 0; k < prod.fraction_mass.size(); ++k)
+      csv += fmt::format("{:g},{},{:g},{:g},{:.9g}\n", rpm, k, edges[k], edges[k + 1], prod.fraction_mass[k]);
+    out.push_back({{"rpm", rpm},
+                   {"conditions", conds.size()},
+                   {"fraction_edges_rel", edges},
+                   {"fraction_mass", prod.fraction_mass},
+                   {"fully_shredded_mass_fraction", prod.single_mass_fraction},
+                   {"largest_piece_mass_fraction", prod.largest_mass_fraction},
+                   {"t10_percent", prod.t10_percent}});
+    ctx.progress.info(fmt::format("[breakage] mill product at {:g} rpm ({} conditions): fully shredded {:.1f}% of the mass, "
+                                  "largest piece {:.1f}%, t10 {:.1f}%",
+                                  rpm, conds.size(), 100 * prod.single_mass_fraction, 100 * prod.largest_mass_fraction,
+                                  prod.t10_percent));
+  }
+  jobs::atomic_write(dir / "product.csv", csv);
+  jobs::atomic_write(dir / "product.json", out.dump(2) + "\n");
 }
 
 }  // namespace mill

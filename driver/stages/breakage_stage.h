@@ -17,6 +17,11 @@ class BreakageStage : public Stage {
   Plan plan(const StageContext& ctx) const override;
   void run_job(StageContext& ctx, const JobSpec& job, const std::filesystem::path& job_dir) override;
   void finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) override;
+
+ private:
+  // breakage/product.csv and product.json: the mill product per rotor speed
+  // when the conditions came from the transport stage.
+  void write_mill_product(StageContext& ctx, const std::vector<JobSpec>& jobs);
 };
 
 // One impact into `out_dir` (used by run_job and by `orchestrate impact`):

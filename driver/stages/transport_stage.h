@@ -1,4 +1,7 @@
-// Stage 'transport': track ore lumps through the sampled flow (LIGGGHTS, one-way coupled)
+// Stage 'transport': ore lumps through the mill in the sampled gas flow
+// (LIGGGHTS, one-way coupled), one job per rotor speed. Each job writes
+// transport/<rpm label>/{impacts.csv, transport.h5, summary.json, plots/*.png}
+// and keeps its LIGGGHTS run (VTK dumps, log) in transport/jobs/<label>/run.
 #pragma once
 
 #include "stages/stage.h"
@@ -8,10 +11,12 @@ namespace mill {
 class TransportStage : public Stage {
  public:
   std::string name() const override { return "transport"; }
-  std::string description() const override { return "track ore lumps through the sampled flow (LIGGGHTS, one-way coupled)"; }
-  bool implemented() const override { return false; }
+  std::string description() const override {
+    return "track ore lumps through the sampled flow (LIGGGHTS, one-way coupled)";
+  }
   Plan plan(const StageContext& ctx) const override;
-  void run_job(StageContext& ctx, const JobSpec& job, const std::filesystem::path& job_dir) override;
+  void run_job(StageContext& ctx, const JobSpec& job,
+               const std::filesystem::path& job_dir) override;
 };
 
 }  // namespace mill

@@ -179,3 +179,39 @@ TEST_F(TinyCampaign, ReportEmbedsTheBreakageResults) {
 }
 
 }  // namespace
+
+namespace {
+
+// Conditions from a (hand-made) transport result: two bins, weights 3:1,
+// and the mill product is their weighted size distribution.
+TEST(MillProduct, ConditionsFromTransportImpacts) {
+  const fs::path dir = scratch("product");
+  fs::create_directories(dir / "transport/rpm2000");
+  std::ofstream(dir / "transport/rpm2000/impacts.csv")
+      << "time_s,particle_id,surface,x_m,y_m,z_m,speed_m_s,normal_speed_m_s,tangential_speed_m_s,angle_deg\n"
+      << "0.01,1,flywheel,0,0,0,5,5,0,90\n0.02,2,flywheel,0,0,0,6,6,0,90\n0.03,3,flywheel,0,0,0,7,7,0,90\n"
+      << "0.04,4,flywheel,0,0,0,80,80,0,90\n0.05,5,housing,0,0,0,30,30,0,90\n";
+  auto o = orchestrate("--case " + kData + "/tiny_product.yaml --stage breakage --list-tasks --output " + dir.string(),
+                       dir / "tasks.log");
+  ASSERT_EQ(o, 0) << slurp(dir / "tasks.log");
+  EXPECT_NE(slurp(dir / "tasks.log").find("rpm2000_b0_v6_a90_r0"), std::string::npos) << slurp(dir / "tasks.log");
+  EXPECT_NE(slurp(dir / "tasks.log").find("rpm2000_b1_v80_a90_r0"), std::string::npos) << slurp(dir / "tasks.log");
+  ASSERT_EQ(orchestrate("--case " + kData + "/tiny_product.yaml --stage breakage --output " + dir.string(),
+                        dir / "run.log"),
+            0)
+      << slurp(dir / "run.log");
+  const auto product = nlohmann::json::parse(slurp(dir / "breakage/product.json"));
+  ASSERT_EQ(product.size(), 1u);
+  const auto& p = product[0];
+  EXPECT_EQ(p.at("conditions").get<int>(), 2);
+  double sum = 0;
+  for (double f : p.at("fraction_mass").get<std::vector<double>>()) sum += f;
+  EXPECT_NEAR(sum, 1.0, 1e-9);
+  // Weighted by hand from the two impacts' own results (3 of 4 impacts in bin 0).
+  const auto rows = mill::post::ReadSummaryCsv((dir / "breakage/summary.csv").string());
+  ASSERT_EQ(rows.size(), 2u);
+  const double expect = 0.75 * rows[0].single_mass_fraction + 0.25 * rows[1].single_mass_fraction;
+  EXPECT_NEAR(p.at("fully_shredded_mass_fraction").get<double>(), expect, 1e-9);
+}
+
+}  // namespace

@@ -1,0 +1,513 @@
+// fix impact/recorder: contact onsets between particles and wall meshes, with
+// the impact velocity relative to the (possibly rotating) struck surface.
+// See docs/styles/fix_impact_recorder.md for keywords, columns and units.
+#include "fix_impact_recorder.h"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+
+#include "abstract_mesh.h"
+#include "atom.h"
+#include "comm.h"
+#include "error.h"
+#include "fix_mesh.h"
+#include "memory.h"
+#include "modify.h"
+#include "update.h"
+
+using namespace LAMMPS_NS;
+using namespace FixConst;
+
+namespace {
+
+constexpr double kRadToDeg = 57.295779513082320876;
+constexpr int kMaxSurfaces = 16;
+
+// Small 3-vector helpers: dot product, difference, cross product c = a x b.
+inline double dot3(const double *a, const double *b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+inline void sub3(const double *a, const double *b, double *c) {
+  for (int k = 0; k < 3; ++k) c[k] = a[k] - b[k];
+}
+inline void cross3(const double *a, const double *b, double *c) {
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+// Nearest point c of triangle (a, b, t) to p, by the Voronoi regions of the
+// triangle's vertices, edges and face (Ericson 2005, Real-Time Collision
+// Detection, sec. 5.1.5).
+void closest_on_triangle(const double *p, const double *a, const double *b, const double *t,
+                         double *c) {
+  double ab[3], at[3], ap[3];
+  sub3(b, a, ab);
+  sub3(t, a, at);
+  sub3(p, a, ap);
+  const double d1 = dot3(ab, ap), d2 = dot3(at, ap);
+  if (d1 <= 0.0 && d2 <= 0.0) {  // vertex a
+    for (int k = 0; k < 3; ++k) c[k] = a[k];
+    return;
+  }
+  double bp[3];
+  sub3(p, b, bp);
+  const double d3 = dot3(ab, bp), d4 = dot3(at, bp);
+  if (d3 >= 0.0 && d4 <= d3) {  // vertex b
+    for (int k = 0; k < 3; ++k) c[k] = b[k];
+    return;
+  }
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {  // edge ab
+    const double v = d1 / (d1 - d3);
+    for (int k = 0; k < 3; ++k) c[k] = a[k] + v * ab[k];
+    return;
+  }
+  double tp[3];
+  sub3(p, t, tp);
+  const double d5 = dot3(ab, tp), d6 = dot3(at, tp);
+  if (d6 >= 0.0 && d5 <= d6) {  // vertex t
+    for (int k = 0; k < 3; ++k) c[k] = t[k];
+    return;
+  }
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {  // edge at
+    const double w = d2 / (d2 - d6);
+    for (int k = 0; k < 3; ++k) c[k] = a[k] + w * at[k];
+    return;
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {  // edge bt
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    for (int k = 0; k < 3; ++k) c[k] = b[k] + w * (t[k] - b[k]);
+    return;
+  }
+  const double denom = 1.0 / (va + vb + vc);  // inside the face
+  const double v = vb * denom, w = vc * denom;
+  for (int k = 0; k < 3; ++k) c[k] = a[k] + ab[k] * v + at[k] * w;
+}
+
+// Parses a number given for keyword key, or fails with a message naming both.
+double parse_number(Error *error, const char *key, const char *text) {
+  char *end = nullptr;
+  errno = 0;
+  const double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
+    const std::string msg =
+        std::string("fix impact/recorder: ") + key + " expects a number, got '" + text + "'";
+    error->all(FLERR, msg.c_str());
+  }
+  return v;
+}
+
+}  // namespace
+
+/* ---------------------------------------------------------------------- */
+
+// Parses keywords, opens the CSV (rank 0) and registers the per-atom state.
+FixImpactRecorder::FixImpactRecorder(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg) {
+  parse_args(narg, arg);
+  vector_flag = 1;
+  size_vector = 1 + static_cast<int>(surfaces_.size());
+  global_freq = 1;
+  extvector = 0;
+  create_attribute = 1;
+  counts_.assign(size_vector, 0.0);
+
+  grow_arrays(atom->nmax);
+  atom->add_callback(0);
+  for (int i = 0; i < atom->nmax; ++i) state_[i] = 0.0;
+
+  if (comm->me == 0) {
+    file_ = fopen(file_path_.c_str(), "w");
+    if (!file_) {
+      const std::string msg = "fix impact/recorder: cannot open file '" + file_path_ + "'";
+      error->one(FLERR, msg.c_str());
+    }
+    fputs(
+        "time_s,particle_id,surface,x_m,y_m,z_m,contact_x_m,contact_y_m,contact_z_m,"
+        "normal_x,normal_y,normal_z,vrel_x_m_s,vrel_y_m_s,vrel_z_m_s,speed_m_s,"
+        "normal_speed_m_s,tangential_speed_m_s,angle_deg,surface_speed_m_s,"
+        "particle_speed_m_s,axis_distance_m\n",
+        file_);
+    fflush(file_);
+  }
+}
+
+// Unregisters the callback, frees storage and closes the CSV.
+FixImpactRecorder::~FixImpactRecorder() {
+  atom->delete_callback(id, 0);
+  memory->destroy(state_);
+  if (file_) fclose(file_);
+}
+
+// Reads `fix ID group impact/recorder file F surface NAME mesh MESHID
+// [omega w origin x y z axis x y z] [surface ...]`; errors name key and value.
+void FixImpactRecorder::parse_args(int narg, char **arg) {
+  auto fail = [this](const std::string &msg) {
+    const std::string m = "fix impact/recorder: " + msg;
+    error->all(FLERR, m.c_str());
+  };
+  auto need = [&](int iarg, int n, const std::string &key) {
+    if (iarg + n >= narg) fail("keyword '" + key + "' needs " + std::to_string(n) + " value(s)");
+  };
+  int iarg = 3;
+  while (iarg < narg) {
+    const std::string key = arg[iarg];
+    if (key == "file") {
+      need(iarg, 1, key);
+      file_path_ = arg[iarg + 1];
+      iarg += 2;
+    } else if (key == "surface") {
+      need(iarg, 3, key);
+      if (std::strcmp(arg[iarg + 2], "mesh") != 0)
+        fail("surface " + std::string(arg[iarg + 1]) + ": expected 'mesh MESH_FIX_ID', got '" +
+             arg[iarg + 2] + "'");
+      Surface s;
+      s.name = arg[iarg + 1];
+      s.mesh_id = arg[iarg + 3];
+      iarg += 4;
+      bool have_omega = false, have_origin = false, have_axis = false;
+      while (iarg < narg && std::strcmp(arg[iarg], "surface") != 0 &&
+             std::strcmp(arg[iarg], "file") != 0) {
+        const std::string sub = arg[iarg];
+        if (sub == "omega") {
+          need(iarg, 1, sub);
+          s.omega = parse_number(error, "omega", arg[iarg + 1]);
+          have_omega = true;
+          iarg += 2;
+        } else if (sub == "origin" || sub == "axis") {
+          need(iarg, 3, sub);
+          auto &v = sub == "origin" ? s.origin : s.axis;
+          for (int d = 0; d < 3; ++d) v[d] = parse_number(error, sub.c_str(), arg[iarg + 1 + d]);
+          (sub == "origin" ? have_origin : have_axis) = true;
+          iarg += 4;
+        } else {
+          fail("surface " + s.name + ": unknown keyword '" + sub +
+               "' (expected omega, origin, axis, surface, file)");
+        }
+      }
+      if (have_omega || have_origin || have_axis) {
+        if (!(have_omega && have_origin && have_axis))
+          fail("surface " + s.name + ": a rotating surface needs all of omega, origin and axis");
+        const double n =
+            std::sqrt(s.axis[0] * s.axis[0] + s.axis[1] * s.axis[1] + s.axis[2] * s.axis[2]);
+        if (!(n > 0.0)) fail("surface " + s.name + ": axis must not be the zero vector");
+        for (auto &a : s.axis) a /= n;
+        s.rotating = true;
+      }
+      surfaces_.push_back(s);
+    } else {
+      fail("unknown keyword '" + key + "' (expected file, surface)");
+    }
+  }
+  if (file_path_.empty()) fail("keyword 'file' (the impact CSV) is required");
+  if (surfaces_.empty()) fail("at least one 'surface NAME mesh MESH_FIX_ID' is required");
+  if (surfaces_.size() > static_cast<size_t>(kMaxSurfaces))
+    fail("at most " + std::to_string(kMaxSurfaces) + " surfaces, got " +
+         std::to_string(surfaces_.size()));
+}
+
+int FixImpactRecorder::setmask() {
+  int mask = 0;
+  mask |= END_OF_STEP;
+  return mask;
+}
+
+// Finds the mesh fixes (they may be defined after this fix) and checks atoms.
+void FixImpactRecorder::init() {
+  if (!atom->radius_flag || !atom->rmass_flag)
+    error->all(FLERR, "fix impact/recorder: needs per-atom radius and mass (atom_style granular)");
+  for (auto &s : surfaces_) {
+    const int ifix = modify->find_fix(s.mesh_id.c_str());
+    if (ifix < 0) {
+      const std::string msg =
+          "fix impact/recorder: surface " + s.name + ": no fix with ID '" + s.mesh_id + "'";
+      error->all(FLERR, msg.c_str());
+    }
+    if (std::strncmp(modify->fix[ifix]->style, "mesh/surface", 12) != 0) {
+      const std::string msg = "fix impact/recorder: surface " + s.name + ": fix '" + s.mesh_id +
+                              "' is a " + modify->fix[ifix]->style + ", not a mesh/surface";
+      error->all(FLERR, msg.c_str());
+    }
+    s.mesh = static_cast<FixMesh *>(modify->fix[ifix]);
+  }
+}
+
+// Marks particles already touching a surface at the start as in contact
+// (no record): only onsets during the run are impacts.
+void FixImpactRecorder::setup(int /*vflag*/) {
+  double **x = atom->x;
+  const double *radius = atom->radius;
+  const int *mask = atom->mask;
+  for (auto &s : surfaces_) {
+    load_triangles(s);
+    set_bound(s);
+  }
+  for (int i = 0; i < atom->nlocal; ++i) {
+    if (!(mask[i] & groupbit)) continue;
+    int bits = static_cast<int>(state_[i]);
+    for (size_t is = 0; is < surfaces_.size(); ++is) {
+      double c[3];
+      if (nearest_point(surfaces_[is], x[i], radius[i], c)) bits |= 1 << is;
+    }
+    state_[i] = bits;
+  }
+}
+
+// Copies the current (moved) triangles of a mesh, owned and ghost, with their
+// unit normals and bounding box.
+void FixImpactRecorder::load_triangles(Surface &s) {
+  AbstractMesh *m = s.mesh->mesh();
+  const int n = m->size();
+  s.tri.resize(9 * static_cast<size_t>(n));
+  s.normal.resize(3 * static_cast<size_t>(n));
+  s.box = {1e300, -1e300, 1e300, -1e300, 1e300, -1e300};
+  for (int t = 0; t < n; ++t) {
+    double *p = &s.tri[9 * static_cast<size_t>(t)];
+    for (int j = 0; j < 3; ++j) {
+      m->node_slow(t, j, p + 3 * j);
+      for (int d = 0; d < 3; ++d) {
+        s.box[2 * d] = std::min(s.box[2 * d], p[3 * j + d]);
+        s.box[2 * d + 1] = std::max(s.box[2 * d + 1], p[3 * j + d]);
+      }
+    }
+    double e1[3], e2[3], nrm[3];
+    sub3(p + 3, p, e1);
+    sub3(p + 6, p, e2);
+    cross3(e1, e2, nrm);
+    const double len = std::sqrt(dot3(nrm, nrm));
+    for (int d = 0; d < 3; ++d) s.normal[3 * t + d] = len > 0.0 ? nrm[d] / len : 0.0;
+  }
+  s.loaded = true;
+}
+
+// A sphere that holds the whole surface at every rotation angle (about the
+// axis for a rotating surface; around the box of a fixed one), from the
+// triangles of all ranks (their elements migrate as the mesh turns).
+// Particles outside it are not checked.
+void FixImpactRecorder::set_bound(Surface &s) {
+  const size_t n = s.tri.size() / 3;  // vertices on this rank
+  if (!s.rotating) {
+    double lo[3], hi[3], glo[3], ghi[3];
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = s.box[2 * d];
+      hi[d] = s.box[2 * d + 1];
+    }
+    MPI_Allreduce(lo, glo, 3, MPI_DOUBLE, MPI_MIN, world);
+    MPI_Allreduce(hi, ghi, 3, MPI_DOUBLE, MPI_MAX, world);
+    double r2 = 0.0;
+    for (int d = 0; d < 3; ++d) {
+      s.bound[d] = 0.5 * (glo[d] + ghi[d]);
+      r2 += 0.25 * (ghi[d] - glo[d]) * (ghi[d] - glo[d]);
+    }
+    s.bound[3] = glo[0] <= ghi[0] ? std::sqrt(r2) : -1.0;
+    return;
+  }
+  double mx[3] = {1e300, -1e300, 0.0};  // -min axial, max axial, max radius^2
+  for (size_t v = 0; v < n; ++v) {
+    double r[3];
+    sub3(&s.tri[3 * v], s.origin.data(), r);
+    const double along = dot3(r, s.axis.data());
+    mx[0] = std::min(mx[0], along);
+    mx[1] = std::max(mx[1], along);
+    mx[2] = std::max(mx[2], dot3(r, r) - along * along);
+  }
+  mx[0] = -mx[0];
+  double g[3];
+  MPI_Allreduce(mx, g, 3, MPI_DOUBLE, MPI_MAX, world);
+  const double amin = -g[0], amax = g[1];
+  const double mid = 0.5 * (amin + amax), half = 0.5 * (amax - amin);
+  for (int d = 0; d < 3; ++d) s.bound[d] = s.origin[d] + mid * s.axis[d];
+  s.bound[3] = amin <= amax ? std::sqrt(g[2] + half * half) : -1.0;
+}
+
+// Nearest point c of the surface to x if closer than radius (contact); false
+// otherwise. Triangles whose plane is farther than radius are skipped cheaply.
+bool FixImpactRecorder::nearest_point(Surface &s, const double *x, double radius, double *c) {
+  double dc[3];
+  sub3(x, s.bound.data(), dc);
+  const double reach = s.bound[3] + radius;
+  if (s.bound[3] < 0.0 || dot3(dc, dc) > reach * reach) return false;
+  if (!s.loaded) load_triangles(s);  // first particle near this surface this step
+  for (int d = 0; d < 3; ++d)
+    if (x[d] < s.box[2 * d] - radius || x[d] > s.box[2 * d + 1] + radius) return false;
+  const size_t n = s.normal.size() / 3;
+  double best = radius * radius;
+  bool found = false;
+  for (size_t t = 0; t < n; ++t) {
+    const double *p = &s.tri[9 * t];
+    double ap[3];
+    sub3(x, p, ap);
+    if (std::fabs(dot3(ap, &s.normal[3 * t])) >= radius) continue;
+    double q[3];
+    closest_on_triangle(x, p, p + 3, p + 6, q);
+    double dq[3];
+    sub3(x, q, dq);
+    const double d2 = dot3(dq, dq);
+    if (d2 < best) {
+      best = d2;
+      for (int k = 0; k < 3; ++k) c[k] = q[k];
+      found = true;
+    }
+  }
+  return found;
+}
+
+// Stores one onset of atom i on surface is at contact point c: velocity
+// relative to the surface there (v - Omega x r for a rotating surface), its
+// normal and tangential parts, and the impact angle to the surface plane.
+void FixImpactRecorder::record(const Surface &s, int is, int i, const double *c) {
+  double **x = atom->x, **v = atom->v, **f = atom->f;
+  // The velocity before this step's contact force: velocity Verlet added
+  // dt/2 f/m of the new force (contact included) in final_integrate.
+  const double half_dt_m = 0.5 * update->dt / atom->rmass[i];
+  const double vpre[3] = {v[i][0] - half_dt_m * f[i][0], v[i][1] - half_dt_m * f[i][1],
+                          v[i][2] - half_dt_m * f[i][2]};
+  double n[3];
+  sub3(x[i], c, n);
+  const double len = std::sqrt(dot3(n, n));
+  for (int k = 0; k < 3; ++k) n[k] = len > 0.0 ? n[k] / len : 0.0;
+  double w[3] = {0.0, 0.0, 0.0}, raxis = 0.0;
+  if (s.rotating) {
+    double r[3], om[3];
+    sub3(c, s.origin.data(), r);
+    const double along = dot3(r, s.axis.data());
+    for (int k = 0; k < 3; ++k) {
+      r[k] -= along * s.axis[k];  // radius vector from the axis
+      om[k] = s.omega * s.axis[k];
+    }
+    raxis = std::sqrt(dot3(r, r));
+    cross3(om, r, w);  // surface velocity Omega x r
+  }
+  double vr[3];
+  sub3(vpre, w, vr);
+  const double vn = -dot3(vr, n);  // approach speed along the normal (> 0 towards the surface)
+  double vt_vec[3];
+  for (int k = 0; k < 3; ++k) vt_vec[k] = vr[k] + vn * n[k];
+  const double vt = std::sqrt(dot3(vt_vec, vt_vec));
+  const double e[NCOL] = {update->get_cur_time(),
+                          static_cast<double>(atom->tag[i]),
+                          static_cast<double>(is),
+                          x[i][0],
+                          x[i][1],
+                          x[i][2],
+                          c[0],
+                          c[1],
+                          c[2],
+                          n[0],
+                          n[1],
+                          n[2],
+                          vr[0],
+                          vr[1],
+                          vr[2],
+                          std::sqrt(dot3(vr, vr)),
+                          vn,
+                          vt,
+                          std::atan2(vn, vt) * kRadToDeg,
+                          std::sqrt(dot3(w, w)),
+                          std::sqrt(dot3(vpre, vpre)),
+                          raxis};
+  events_.insert(events_.end(), e, e + NCOL);
+}
+
+// Detects onsets after the step's integration (particles and meshes at the
+// same time), then gathers the step's records on rank 0 (one reduction).
+void FixImpactRecorder::end_of_step() {
+  double **x = atom->x;
+  const double *radius = atom->radius;
+  const int *mask = atom->mask;
+  for (auto &s : surfaces_) s.loaded = false;  // triangles are fetched lazily
+  for (int i = 0; i < atom->nlocal; ++i) {
+    if (!(mask[i] & groupbit)) continue;
+    int bits = static_cast<int>(state_[i]);
+    for (size_t is = 0; is < surfaces_.size(); ++is) {
+      double c[3];
+      const int bit = 1 << is;
+      if (nearest_point(surfaces_[is], x[i], radius[i], c)) {
+        if (!(bits & bit)) record(surfaces_[is], static_cast<int>(is), i, c);
+        bits |= bit;
+      } else {
+        bits &= ~bit;
+      }
+    }
+    state_[i] = bits;
+  }
+  flush_events();
+}
+
+// Gathers this step's records to rank 0, appends them to the CSV and updates
+// the cached counts.
+void FixImpactRecorder::flush_events() {
+  const int nlocal_ev = static_cast<int>(events_.size() / NCOL);
+  int ntotal = 0;
+  MPI_Allreduce(&nlocal_ev, &ntotal, 1, MPI_INT, MPI_SUM, world);
+  if (ntotal == 0) return;
+  std::vector<double> all;
+  if (comm->nprocs == 1) {
+    all.swap(events_);
+  } else {
+    const int nsend = nlocal_ev * NCOL;
+    std::vector<int> counts(comm->nprocs), displs(comm->nprocs);
+    MPI_Gather(&nsend, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
+    if (comm->me == 0) {
+      for (int p = 1; p < comm->nprocs; ++p) displs[p] = displs[p - 1] + counts[p - 1];
+      all.resize(static_cast<size_t>(ntotal) * NCOL);
+    }
+    MPI_Gatherv(events_.data(), nsend, MPI_DOUBLE, all.data(), counts.data(), displs.data(),
+                MPI_DOUBLE, 0, world);
+  }
+  events_.clear();
+  if (comm->me == 0) {
+    for (size_t e = 0; e + NCOL <= all.size(); e += NCOL) {
+      const double *r = &all[e];
+      const int is = static_cast<int>(r[SURFACE]);
+      fprintf(file_, "%.9g,%.0f,%s", r[TIME], r[TAG], surfaces_[is].name.c_str());
+      for (int k = X; k < NCOL; ++k) fprintf(file_, ",%.9g", r[k]);
+      fputc('\n', file_);
+      counts_[0] += 1.0;
+      counts_[1 + is] += 1.0;
+    }
+    fflush(file_);
+  }
+  MPI_Bcast(counts_.data(), static_cast<int>(counts_.size()), MPI_DOUBLE, 0, world);
+}
+
+// 1: impacts recorded so far, 1 + s: impacts on surface s (in keyword order).
+double FixImpactRecorder::compute_vector(int n) {
+  return n >= 0 && n < static_cast<int>(counts_.size()) ? counts_[n] : 0.0;
+}
+
+// Per-atom contact bits.
+void FixImpactRecorder::grow_arrays(int nmax) {
+  memory->grow(state_, nmax, "impact/recorder:state");
+  for (int i = nmax_; i < nmax; ++i) state_[i] = 0.0;
+  nmax_ = nmax;
+}
+
+void FixImpactRecorder::copy_arrays(int i, int j, int /*delflag*/) { state_[j] = state_[i]; }
+
+// A new atom starts without contacts.
+void FixImpactRecorder::set_arrays(int i) { state_[i] = 0.0; }
+
+int FixImpactRecorder::pack_exchange(int i, double *buf) {
+  buf[0] = state_[i];
+  return 1;
+}
+
+int FixImpactRecorder::unpack_exchange(int nlocal, double *buf) {
+  state_[nlocal] = buf[0];
+  return 1;
+}
+
+double FixImpactRecorder::memory_usage() {
+  double bytes = static_cast<double>(nmax_) * sizeof(double);
+  for (const auto &s : surfaces_) bytes += (s.tri.size() + s.normal.size()) * sizeof(double);
+  return bytes;
+}

@@ -1,0 +1,104 @@
+// fix impact/recorder: records every contact onset between a particle and a
+// wall mesh (fix mesh/surface), with the velocity relative to the struck
+// surface, for LIGGGHTS 3.8. See docs/styles/fix_impact_recorder.md.
+//
+// Contact is decided geometrically, with the criterion fix wall/gran uses for
+// meshes: the distance from the particle centre to the nearest triangle is
+// below the radius. A per-atom bit per surface remembers "in contact" so that
+// only onsets are recorded; it travels with the atom between ranks.
+#ifndef MILL_FIX_IMPACT_RECORDER_H
+#define MILL_FIX_IMPACT_RECORDER_H
+
+#include <array>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "fix.h"
+
+namespace LAMMPS_NS {
+
+class FixImpactRecorder : public Fix {
+ public:
+  FixImpactRecorder(class LAMMPS *lmp, int narg, char **arg);
+  ~FixImpactRecorder() override;
+
+  static const char *style_name() { return "impact/recorder"; }
+
+  int setmask() override;
+  void init() override;
+  void setup(int vflag) override;
+  void end_of_step() override;
+  double compute_vector(int n) override;
+
+  void grow_arrays(int nmax) override;
+  void copy_arrays(int i, int j, int delflag) override;
+  void set_arrays(int i) override;
+  int pack_exchange(int i, double *buf) override;
+  int unpack_exchange(int nlocal, double *buf) override;
+  double memory_usage() override;
+
+  // Columns of one impact record (also the CSV columns after time and id).
+  enum Column {
+    TIME = 0,
+    TAG,
+    SURFACE,
+    X,
+    Y,
+    Z,
+    CX,
+    CY,
+    CZ,
+    NX,
+    NY,
+    NZ,
+    VRX,
+    VRY,
+    VRZ,
+    SPEED,
+    VN,
+    VT,
+    ANGLE,
+    WSPEED,
+    VABS,
+    RAXIS,
+    NCOL
+  };
+
+ private:
+  struct Surface {
+    std::string name;     // label written to the CSV ("flywheel")
+    std::string mesh_id;  // ID of its fix mesh/surface
+    class FixMesh *mesh = nullptr;
+    bool rotating = false;
+    double omega = 0.0;                     // angular speed about axis [rad/s]
+    std::array<double, 3> origin{0, 0, 0};  // a point on the axis        [m]
+    std::array<double, 3> axis{0, 0, 1};    // unit axis (right-hand rule)
+    std::vector<double> tri;                // 9 doubles per triangle, this step
+    std::vector<double> normal;             // 3 doubles per triangle (unit)
+    std::array<double, 6> box{};            // bounding box of the triangles
+    std::array<double, 4> bound{};  // sphere holding the surface at any angle: centre, radius
+    bool loaded = false;            // tri, normal, box are this step's
+  };
+  std::vector<Surface> surfaces_;
+  std::string file_path_;
+  FILE *file_ = nullptr;  // rank 0 only
+
+  // Cached counts (read by compute_vector): total, then one per surface.
+  std::vector<double> counts_;
+
+  int nmax_ = 0;
+  double *state_ = nullptr;     // per atom: bit s set while in contact with surface s
+  std::vector<double> events_;  // this step's onsets on this rank, NCOL per event
+
+  void parse_args(int narg, char **arg);
+  void load_triangles(Surface &s);
+  void set_bound(Surface &s);
+  bool nearest_point(Surface &s, const double *x, double radius, double *c);
+  void record(const Surface &s, int is, int i, const double *c);
+  void flush_events();
+};
+
+}  // namespace LAMMPS_NS
+
+#endif

@@ -1,0 +1,175 @@
+// The transport stage end to end with real LIGGGHTS runs, on a synthetic gas
+// field (solid-body rotation plus a downdraft inside a small housing) written
+// with write_flow_field where the sample stage would put it.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "postprocess/flow_field_io.h"
+#include "postprocess/impact_stats.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A small mill: 1.2 m housing, 0.5 m flywheel at 2000 rpm, 6 lumps of 30 mm.
+const char* kCase = R"(name: tiny_transport
+mill:
+  housing: {height: 1.2, width: 0.8, depth: 0.3}
+  flywheel: {diameter: 0.5, hub_diameter: 0.15, n_plates: 4, plate_width: 0.2, plate_thickness: 0.02, axis_height: 0.45}
+  inlet: {center_x: -0.15, size: 0.15}
+  outlet: {center_x: 0.0, size: 0.3}
+rotor: {rpm: [2000]}
+injection: {n_lumps: 6, lump_diameter: 0.03, duration: 0.02, time_limit: 0.2, timestep: 5.0e-6}
+transport: {trajectory_interval: 2.0e-3, vtk_interval: 0.05}
+ore: {card: sandstone}
+resources: {np: 1, jobs: 1}
+)";
+
+fs::path scratch(const std::string& name) {
+  fs::path d = fs::temp_directory_path() / ("mill_e2e_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+// Run orchestrate to completion; returns its exit status, output in `log`.
+int orchestrate(const std::string& args, const fs::path& log) {
+  const std::string cmd = "MILL_LIGGGHTS='" + std::string(LIGGGHTS_MILL_EXE) + "' '" +
+                          ORCHESTRATE_EXE + "' " + args + " > '" + log.string() + "' 2>&1";
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+std::string slurp(const fs::path& f) {
+  std::ifstream in(f);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// Solid-body rotation at a tenth of the rotor speed about the rotor axis plus
+// a 2 m/s downdraft, inside the housing; no gas inside the hub.
+void write_synthetic_field(const fs::path& file) {
+  mill::post::FlowField f;
+  const double h = 0.05;
+  f.origin = {-0.4, 0.0, -0.15};
+  f.spacing = {h, h, h};
+  f.dims = {17, 25, 7};
+  f.allocate(false);
+  const double omega = 0.1 * 2000 * 2 * kPi / 60, ax = 0.0, ay = 0.45;
+  for (int k = 0; k < f.dims[2]; ++k)
+    for (int j = 0; j < f.dims[1]; ++j)
+      for (int i = 0; i < f.dims[0]; ++i) {
+        const size_t p = f.point(i, j, k);
+        const double x = f.origin[0] + i * h, y = f.origin[1] + j * h;
+        const double rx = x - ax, ry = y - ay;
+        const bool gas = std::hypot(rx, ry) > 0.075;
+        f.mask[p] = gas ? 1 : 0;
+        if (!gas) continue;
+        f.U[3 * p + 0] = -omega * ry;
+        f.U[3 * p + 1] = omega * rx - 2.0;
+        f.rho[p] = 1.2;
+      }
+  f.rpm = 2000;
+  f.gas_model = "incompressible";
+  f.source =
+      "synthetic: solid-body rotation at 0.1 x rotor speed plus a 2 m/s downdraft "
+      "(test_transport_e2e)";
+  mill::post::write_flow_field(file, f);
+}
+
+class TinyTransport : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(scratch("transport"));
+    std::ofstream(*dir_ / "case.yaml") << kCase;
+    write_synthetic_field(*dir_ / "run" / "sample" / "rpm2000" / "field.h5");
+    status_ = orchestrate("--case " + (*dir_ / "case.yaml").string() +
+                              " --stage transport --output " + (*dir_ / "run").string(),
+                          *dir_ / "transport.log");
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static fs::path* dir_;
+  static int status_;
+};
+fs::path* TinyTransport::dir_ = nullptr;
+int TinyTransport::status_ = -1;
+
+TEST_F(TinyTransport, RunsAndWritesEveryOutput) {
+  ASSERT_EQ(status_, 0) << slurp(*dir_ / "transport.log");
+  const fs::path out = *dir_ / "run" / "transport" / "rpm2000";
+  for (const char* f : {"impacts.csv", "transport.h5", "summary.json", "plots/trajectories.png",
+                        "plots/flywheel_impact_speed.png", "plots/flywheel_normal_speed.png",
+                        "plots/flywheel_angle.png", "plots/collisions_per_particle.png"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  EXPECT_EQ(mill::post::dataset_unit(out / "transport.h5", "impacts/speed"), "m/s");
+  EXPECT_EQ(mill::post::dataset_unit(out / "transport.h5", "impacts/angle"), "deg");
+  EXPECT_EQ(mill::post::dataset_unit(out / "transport.h5", "trajectories/position"), "m");
+  const std::string log = slurp(*dir_ / "transport.log");
+  EXPECT_NE(log.find("cross-check: rim speed 52.4 m/s"), std::string::npos) << log;
+}
+
+// Lumps fall onto the spinning flywheel: impacts relative to the beaters are
+// of the order of the rim speed (52 m/s), and the summary is consistent with
+// the impact list.
+TEST_F(TinyTransport, ImpactStatisticsArePlausible) {
+  ASSERT_EQ(status_, 0);
+  const fs::path out = *dir_ / "run" / "transport" / "rpm2000";
+  const auto j = nlohmann::json::parse(slurp(out / "summary.json"));
+  EXPECT_EQ(j.at("n_particles").get<long>(), 6);
+  const long nfly = j.at("n_flywheel_impacts").get<long>();
+  EXPECT_GE(nfly, 3);
+  const double rim = 2000 * 2 * kPi / 60 * 0.25;
+  const double v = j.at("flywheel_impact_speed_mean_m_s").get<double>();
+  EXPECT_GT(v, 0.2 * rim);
+  EXPECT_LT(v, 1.5 * rim);
+  const auto rec = mill::post::ReadImpactsCsv((out / "impacts.csv").string());
+  long n = 0;
+  for (const auto& r : rec) n += r.surface == "flywheel";
+  EXPECT_EQ(n, nfly);
+  EXPECT_EQ(static_cast<long>(rec.size()), nfly + j.at("n_wall_impacts").get<long>());
+  for (const char* k :
+       {"flywheel_impact_speed_std_m_s", "flywheel_normal_speed_mean_m_s",
+        "flywheel_angle_mean_deg", "impacts_per_particle_mean", "first_impact_time_mean_s"})
+    EXPECT_TRUE(j.contains(k)) << k;
+}
+
+// Without the sample stage's field the stage fails and names the file and the command.
+TEST(TransportMissingField, NamesFileAndCommand) {
+  const fs::path dir = scratch("transport_missing");
+  std::ofstream(dir / "case.yaml") << kCase;
+  const int st = orchestrate("--case " + (dir / "case.yaml").string() +
+                                 " --stage transport --output " + (dir / "run").string(),
+                             dir / "log");
+  EXPECT_NE(st, 0);
+  const std::string log = slurp(dir / "log");
+  EXPECT_NE(log.find("sample/rpm2000/field.h5"), std::string::npos) << log;
+  EXPECT_NE(log.find("--stage sample"), std::string::npos) << log;
+}
+
+}  // namespace
+
+namespace {
+
+// A time limit shorter than the injection is refused, naming the key.
+TEST(TransportBadInput, TimeLimitBelowDurationNamesKey) {
+  const fs::path dir = scratch("transport_badtime");
+  std::string text = kCase;
+  text.replace(text.find("time_limit: 0.2"), 15, "time_limit: 0.01");
+  std::ofstream(dir / "case.yaml") << text;
+  write_synthetic_field(dir / "run" / "sample" / "rpm2000" / "field.h5");
+  const int st = orchestrate("--case " + (dir / "case.yaml").string() +
+                                 " --stage transport --output " + (dir / "run").string(),
+                             dir / "log");
+  EXPECT_NE(st, 0);
+  const std::string log = slurp(dir / "log");
+  EXPECT_NE(log.find("injection.time_limit"), std::string::npos) << log;
+}
+
+}  // namespace
