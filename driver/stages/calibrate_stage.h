@@ -1,4 +1,7 @@
-// Stage 'calibrate': fit bond parameters to the ore card (virtual UCS and Brazilian tests)
+// Stage 'calibrate': fit the bond (micro) parameters to the ore card's macro
+// properties with virtual UCS and Brazilian tests on a bonded specimen packed
+// like the lump; writes calibrate/calibrated.yaml (read by the breakage
+// stage), report.md, report.json, curves.csv and plots/. See docs/calibration.md.
 #pragma once
 
 #include "stages/stage.h"
@@ -8,10 +11,13 @@ namespace mill {
 class CalibrateStage : public Stage {
  public:
   std::string name() const override { return "calibrate"; }
-  std::string description() const override { return "fit bond parameters to the ore card (virtual UCS and Brazilian tests)"; }
-  bool implemented() const override { return false; }
+  std::string description() const override {
+    return "fit bond parameters to the ore card (virtual UCS and Brazilian tests)";
+  }
   Plan plan(const StageContext& ctx) const override;
-  void run_job(StageContext& ctx, const JobSpec& job, const std::filesystem::path& job_dir) override;
+  void run_job(StageContext& ctx, const JobSpec& job,
+               const std::filesystem::path& job_dir) override;
+  void finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) override;
 };
 
 }  // namespace mill

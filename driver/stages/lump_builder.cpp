@@ -41,6 +41,10 @@ bool is_prime(long n) {
     if (n % i == 0) return false;
   return true;
 }
+long next_prime(long n) {
+  while (!is_prime(n)) ++n;
+  return n;
+}
 // LIGGGHTS wants distinct prime seeds > 10000; the deck's own templates use 10007-10061.
 long prime_seed(long base) {
   long n = 20000 + (base % 1000000) * 7;
@@ -102,7 +106,7 @@ LumpInfo ensure_lump(StageContext& ctx, const LumpSpec& s, int packing, const st
   const std::string label = fmt::format("n{}_p{}", s.n_elements, packing);
   nlohmann::json in = {{"n_elements", s.n_elements}, {"diameter", s.diameter}, {"spread", s.spread},
                        {"seed", s.seed + packing},   {"bond_gap", s.bond_gap}, {"max_bonds", s.max_bonds},
-                       {"density", s.density},       {"nu", s.nu},             {"deck_version", 1}};
+                       {"density", s.density},       {"nu", s.nu},             {"deck_version", 2}};
   jobs::JobStore store(base);
   FileLock lock(base / (label + ".lock"));
   const fs::path dir = store.job_dir(label);
@@ -127,6 +131,10 @@ LumpInfo ensure_lump(StageContext& ctx, const LumpSpec& s, int packing, const st
     const double t_pull = 2.5 * std::sqrt(2.0 * r_insert / pull);  // time to jam, with margin
     const double m_mean = s.density * 4.0 / 3.0 * M_PI * rm * rm * rm;
     const double gamma = m_mean / 0.03;  // viscous relaxation time 30 ms
+    // Two distinct primes (two LIGGGHTS fixes sharing a seed abort silently).
+    const long seed_dist = prime_seed(2 * (s.seed + packing));
+    long seed_ins = prime_seed(2 * (s.seed + packing) + 1);
+    if (seed_ins == seed_dist) seed_ins = next_prime(seed_dist + 1);
     fs::path tmp = dir / "build";
     fs::remove_all(tmp);
     engine::DeckRun run;
@@ -145,8 +153,8 @@ LumpInfo ensure_lump(StageContext& ctx, const LumpSpec& s, int packing, const st
                 {"n_compact", std::to_string(static_cast<long>(std::ceil(t_pull / dt)))},
                 {"n_relax", std::to_string(static_cast<long>(std::ceil(0.3 * t_pull / dt)))},
                 {"skin", num(0.3 * rm)},
-                {"seed_dist", std::to_string(prime_seed(2 * (s.seed + packing)))},
-                {"seed_ins", std::to_string(prime_seed(2 * (s.seed + packing) + 1))},
+                {"seed_dist", std::to_string(seed_dist)},
+                {"seed_ins", std::to_string(seed_ins)},
                 {"bond_gap", num(s.bond_gap)},
                 {"max_bonds", std::to_string(s.max_bonds)},
                 {"r_mean", num(rm)},

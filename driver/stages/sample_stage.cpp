@@ -1,10 +1,259 @@
-// Stage 'sample': resample each flow solution on a uniform grid (issue 6).
+// Stage 'sample': the flow solution on a uniform grid (HDF5, VTI, PNG).
 #include "stages/sample_stage.h"
 
+#include <fmt/format.h>
+#include <unistd.h>
+#include <vtkCompositeDataSet.h>
+#include <vtkDataArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkImageData.h>
+#include <vtkLookupTable.h>
+#include <vtkOpenFOAMReader.h>
+#include <vtkPNGWriter.h>
+#include <vtkPointData.h>
+#include <vtkResampleToImage.h>
+#include <vtkSmartPointer.h>
+#include <vtkUnsignedCharArray.h>
+#include <vtkXMLImageDataWriter.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "geometry/mill_geometry.h"
+#include "jobs/job_store.h"
+#include "progress.h"
+#include "stages/flow_stage.h"
 #include "stages/stage_util.h"
 
 namespace mill {
+namespace fs = std::filesystem;
 
+namespace sample {
+namespace {
+
+constexpr double kAirGasConstant =
+    8314.462618 / 28.96;  // J/(kg K), as in the case's perfectGas (molWeight 28.96)
+
+template <typename T>
+using Ptr = vtkSmartPointer<T>;
+
+// Copy one VTK point array (nc components) into dst, zero where mask = 0.
+void take(vtkDataArray* a, int nc, const std::vector<std::uint8_t>& mask,
+          std::vector<double>& dst) {
+  const vtkIdType n = static_cast<vtkIdType>(mask.size());
+  for (vtkIdType i = 0; i < n; ++i)
+    for (int c = 0; c < nc; ++c) dst[nc * i + c] = mask[i] ? a->GetComponent(i, c) : 0.0;
+}
+
+}  // namespace
+
+// Grid of exact spacing centred in the box.
+post::FlowField make_grid(const GridSpec& g) {
+  post::FlowField f;
+  for (int d = 0; d < 3; ++d) {
+    const double L = g.hi[d] - g.lo[d];
+    const int n = std::max(2, static_cast<int>(std::floor(L / g.spacing + 1e-9)) + 1);
+    f.dims[d] = n;
+    f.spacing[d] = g.spacing;
+    f.origin[d] = g.lo[d] + 0.5 * (L - (n - 1) * g.spacing);
+  }
+  return f;
+}
+
+// vtkOpenFOAMReader -> vtkResampleToImage -> FlowField.
+post::FlowField resample_case(const fs::path& case_dir, const GridSpec& grid, const Options& opt) {
+  const fs::path foam = case_dir / "case.foam";
+  if (!fs::exists(case_dir / "constant" / "polyMesh"))
+    throw std::runtime_error(
+        fmt::format("{}: no mesh (constant/polyMesh) to sample", case_dir.string()));
+  if (!fs::exists(foam)) std::ofstream(foam).close();
+
+  auto reader = Ptr<vtkOpenFOAMReader>::New();
+  reader->SetFileName(foam.c_str());
+  reader->SetSkipZeroTime(true);  // 0/ holds the template fields (with $macros), never a result
+  reader->SetCreateCellToPoint(1);
+  // Keep snappyHexMesh's split-hex cells as polyhedra: decomposed, points on
+  // refinement-level interfaces fall between the pieces and come out masked.
+  reader->SetDecomposePolyhedra(0);
+  reader->UpdateInformation();
+  reader->DisableAllPatchArrays();
+  reader->SetPatchArrayStatus("internalMesh", 1);
+  reader->DisableAllLagrangianArrays();
+  reader->DisableAllPointArrays();
+  reader->DisableAllCellArrays();
+  auto has_cell_array = [&](const char* name) {
+    for (int i = 0; i < reader->GetNumberOfCellArrays(); ++i)
+      if (std::string(reader->GetCellArrayName(i)) == name) return true;
+    return false;
+  };
+  std::vector<std::string> want{"U"};
+  const bool read_rho = opt.constant_rho <= 0;
+  if (read_rho) {
+    if (has_cell_array("rho"))
+      want.push_back("rho");
+    else
+      want.insert(want.end(), {"p", "T"});
+  }
+  if (opt.turbulence) want.insert(want.end(), {"k", "omega"});
+  for (const auto& w : want) {
+    if (!has_cell_array(w.c_str()))
+      throw std::runtime_error(fmt::format(
+          "{}: field '{}' not found in the latest time folder (has the flow stage finished?)",
+          case_dir.string(), w));
+    reader->SetCellArrayStatus(w.c_str(), 1);
+  }
+  vtkDoubleArray* times = reader->GetTimeValues();
+  const double t = (times && times->GetNumberOfTuples() > 0)
+                       ? times->GetValue(times->GetNumberOfTuples() - 1)
+                       : 0.0;
+
+  post::FlowField f = make_grid(grid);
+  auto rs = Ptr<vtkResampleToImage>::New();
+  rs->SetInputConnection(reader->GetOutputPort());
+  rs->SetUseInputBounds(false);
+  // Probe slightly inside the nominal box: points exactly on the housing walls
+  // would otherwise fall in or out of the mesh by round-off, and snapping
+  // moves wall points by a fraction of a millimetre (see grid.wall_inset).
+  double b[6];
+  for (int d = 0; d < 3; ++d) {
+    const double e = std::max(1e-6 * f.spacing[d], grid.wall_inset);
+    b[2 * d] = f.origin[d] + e;
+    b[2 * d + 1] = f.origin[d] + (f.dims[d] - 1) * f.spacing[d] - e;
+  }
+  rs->SetSamplingBounds(b);
+  rs->SetSamplingDimensions(f.dims[0], f.dims[1], f.dims[2]);
+  rs->UpdateTimeStep(t);
+  vtkImageData* img = rs->GetOutput();
+  if (!img || img->GetNumberOfPoints() != static_cast<vtkIdType>(f.size()))
+    throw std::runtime_error(fmt::format("{}: resampling produced no grid", case_dir.string()));
+
+  f.allocate(opt.turbulence);
+  vtkPointData* pd = img->GetPointData();
+  vtkDataArray* valid = pd->GetArray(rs->GetMaskArrayName());
+  vtkDataArray* U = pd->GetArray("U");
+  if (!valid || !U)
+    throw std::runtime_error(
+        fmt::format("{}: resampled grid lacks U or the mask", case_dir.string()));
+  for (size_t i = 0; i < f.size(); ++i) f.mask[i] = valid->GetComponent(i, 0) > 0.5 ? 1 : 0;
+  take(U, 3, f.mask, f.U);
+  if (!read_rho) {
+    for (size_t i = 0; i < f.size(); ++i) f.rho[i] = f.mask[i] ? opt.constant_rho : 0.0;
+  } else if (vtkDataArray* r = pd->GetArray("rho")) {
+    take(r, 1, f.mask, f.rho);
+  } else {
+    vtkDataArray *p = pd->GetArray("p"), *T = pd->GetArray("T");
+    for (size_t i = 0; i < f.size(); ++i)
+      f.rho[i] =
+          f.mask[i] ? p->GetComponent(i, 0) / (kAirGasConstant * T->GetComponent(i, 0)) : 0.0;
+  }
+  if (opt.turbulence) {
+    take(pd->GetArray("k"), 1, f.mask, f.k);
+    take(pd->GetArray("omega"), 1, f.mask, f.omega);
+  }
+  f.source =
+      fmt::format("{} (time {:g}), vtkOpenFOAMReader + vtkResampleToImage", case_dir.string(), t);
+  return f;
+}
+
+// FlowField -> vtkImageData -> XML (.vti, binary appended, compressed).
+void write_vti(const fs::path& file, const post::FlowField& f) {
+  auto img = Ptr<vtkImageData>::New();
+  img->SetDimensions(f.dims[0], f.dims[1], f.dims[2]);
+  img->SetOrigin(f.origin[0], f.origin[1], f.origin[2]);
+  img->SetSpacing(f.spacing[0], f.spacing[1], f.spacing[2]);
+  const vtkIdType n = static_cast<vtkIdType>(f.size());
+  auto add = [&](const char* name, int nc, const std::vector<double>& v) {
+    if (v.empty()) return;
+    auto a = Ptr<vtkDoubleArray>::New();
+    a->SetName(name);
+    a->SetNumberOfComponents(nc);
+    a->SetNumberOfTuples(n);
+    for (vtkIdType i = 0; i < n * nc; ++i) a->SetValue(i, v[i]);
+    img->GetPointData()->AddArray(a);
+  };
+  add("U", 3, f.U);
+  add("rho", 1, f.rho);
+  add("k", 1, f.k);
+  add("omega", 1, f.omega);
+  auto m = Ptr<vtkUnsignedCharArray>::New();
+  m->SetName("mask");
+  m->SetNumberOfTuples(n);
+  for (vtkIdType i = 0; i < n; ++i) m->SetValue(i, f.mask[i]);
+  img->GetPointData()->AddArray(m);
+  img->GetPointData()->SetActiveVectors("U");
+
+  auto w = Ptr<vtkXMLImageDataWriter>::New();
+  w->SetFileName(file.c_str());
+  w->SetInputData(img);
+  w->SetDataModeToAppended();
+  if (!w->Write()) throw std::runtime_error("cannot write " + file.string());
+}
+
+// |U| on the plane k nearest to z, bilinear, upscaled to ~800 px high.
+std::array<double, 2> write_midplane_png(const fs::path& file, const post::FlowField& f, double z) {
+  const int nx = f.dims[0], ny = f.dims[1];
+  const int k =
+      std::clamp(static_cast<int>(std::lround((z - f.origin[2]) / f.spacing[2])), 0, f.dims[2] - 1);
+  std::vector<double> speed(static_cast<size_t>(nx) * ny);
+  double vmax = 0;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const size_t p = f.point(i, j, k);
+      const double s = std::sqrt(f.U[3 * p] * f.U[3 * p] + f.U[3 * p + 1] * f.U[3 * p + 1] +
+                                 f.U[3 * p + 2] * f.U[3 * p + 2]);
+      speed[static_cast<size_t>(j) * nx + i] = f.mask[p] ? s : NAN;
+      if (f.mask[p]) vmax = std::max(vmax, s);
+    }
+  if (vmax <= 0) vmax = 1;
+
+  auto lut = Ptr<vtkLookupTable>::New();
+  lut->SetHueRange(0.667, 0.0);  // blue (slow) -> red (fast)
+  lut->SetTableRange(0, vmax);
+  lut->SetNanColor(0.6, 0.6, 0.6, 1.0);
+  lut->Build();
+
+  const int scale = std::max(1, 800 / std::max(ny - 1, 1));
+  const int W = (nx - 1) * scale + 1, H = (ny - 1) * scale + 1, bar = std::max(12, W / 12), gap = 6;
+  auto img = Ptr<vtkImageData>::New();
+  img->SetDimensions(W + gap + bar, H, 1);
+  img->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
+  auto put = [&](int x, int y, const unsigned char* rgb) {
+    auto* px = static_cast<unsigned char*>(img->GetScalarPointer(x, y, 0));
+    px[0] = rgb[0], px[1] = rgb[1], px[2] = rgb[2];
+  };
+  const unsigned char white[3] = {255, 255, 255};
+  for (int y = 0; y < H; ++y) {
+    for (int x = 0; x < W; ++x) {
+      const double fx = static_cast<double>(x) / scale, fy = static_cast<double>(y) / scale;
+      const int i = std::min(static_cast<int>(fx), nx - 2),
+                j = std::min(static_cast<int>(fy), ny - 2);
+      const double wx = fx - i, wy = fy - j;
+      const double v00 = speed[j * nx + i], v10 = speed[j * nx + i + 1],
+                   v01 = speed[(j + 1) * nx + i], v11 = speed[(j + 1) * nx + i + 1];
+      double v;
+      if (std::isnan(v00) || std::isnan(v10) || std::isnan(v01) ||
+          std::isnan(v11))  // nearest near solids
+        v = speed[static_cast<size_t>(std::lround(fy)) * nx + std::lround(fx)];
+      else
+        v = (1 - wx) * (1 - wy) * v00 + wx * (1 - wy) * v10 + (1 - wx) * wy * v01 + wx * wy * v11;
+      put(x, y, lut->MapValue(v));  // image y grows upwards in VTK: the floor is at the bottom
+    }
+    for (int x = W; x < W + gap; ++x) put(x, y, white);
+    for (int x = W + gap; x < W + gap + bar; ++x)
+      put(x, y, lut->MapValue(vmax * y / std::max(H - 1, 1)));
+  }
+  auto w = Ptr<vtkPNGWriter>::New();
+  w->SetFileName(file.c_str());
+  w->SetInputData(img);
+  w->Write();
+  if (!fs::exists(file)) throw std::runtime_error("cannot write " + file.string());
+  return {0.0, vmax};
+}
+
+}  // namespace sample
+
+// One job per rotor speed, matching the flow stage's jobs.
 Plan SampleStage::plan(const StageContext& ctx) const {
   Plan p;
   for (double rpm : ctx.cfg.doc.reals("rotor.rpm")) {
@@ -15,8 +264,73 @@ Plan SampleStage::plan(const StageContext& ctx) const {
   return p;
 }
 
-void SampleStage::run_job(StageContext&, const JobSpec&, const std::filesystem::path&) {
-  throw NotImplemented("stage 'sample' is not implemented yet (issue 6: sampled velocity field)");
+// flow/<label>/case -> sample/<label>/{field.h5, field.vti, midplane_speed.png}.
+void SampleStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path&) {
+  const auto& doc = ctx.cfg.doc;
+  const fs::path flow_out = flow::output_dir(ctx.run_dir, job.label);
+  if (!fs::exists(flow_out / "flow_report.json"))
+    throw MissingInput(
+        fmt::format("stage sample needs {} (the flow solution at {}); run --stage flow first",
+                    (flow_out / "flow_report.json").string(), job.label));
+  const auto geo = geometry::MillGeometry::from_config(doc);
+  sample::GridSpec grid;
+  grid.lo = {-0.5 * geo.width, 0.0, -0.5 * geo.depth};
+  grid.hi = {0.5 * geo.width, geo.height, 0.5 * geo.depth};
+  grid.spacing = doc.real("sample.spacing");
+  const double min_side = std::min({geo.width, geo.height, geo.depth});
+  grid.wall_inset = 2e-3 * min_side;
+  if (grid.spacing > 0.5 * min_side)
+    throw std::invalid_argument(
+        fmt::format("{}: spacing {:g} m is too coarse for a {:g} m housing side (max {:g} m)",
+                    doc.where("sample.spacing"), grid.spacing, min_side, 0.5 * min_side));
+  sample::Options opt;
+  opt.turbulence = doc.boolean("sample.turbulence");
+  const bool comp = doc.str("gas.model") == "compressible";
+  if (!comp) opt.constant_rho = doc.real("gas.density");
+
+  ctx.progress.job_step(job.label, "resample", -1);
+  post::FlowField f = sample::resample_case(flow_out / "case", grid, opt);
+  f.rpm = job.inputs.at("rotor.rpm").get<double>();
+  f.gas_model = doc.str("gas.model");
+  f.source = "flow/" + job.label + "/case, vtkOpenFOAMReader + vtkResampleToImage";
+
+  size_t gas = 0;
+  double umax = 0;
+  for (size_t i = 0; i < f.size(); ++i) {
+    gas += f.mask[i];
+    umax = std::max(umax, std::hypot(f.U[3 * i], f.U[3 * i + 1], f.U[3 * i + 2]));
+  }
+  if (gas == 0)
+    throw std::runtime_error(
+        fmt::format("no grid point fell inside the gas mesh of {}", (flow_out / "case").string()));
+
+  const fs::path out = ctx.stage_dir / job.label;
+  const fs::path tmp = out.string() + ".tmp." + std::to_string(getpid());
+  fs::remove_all(tmp);
+  fs::create_directories(tmp);
+  post::write_flow_field(tmp / "field.h5", f);
+  sample::write_vti(tmp / "field.vti", f);
+  const auto range = sample::write_midplane_png(tmp / "midplane_speed.png", f, 0.0);
+  nlohmann::json rep = {{"rpm", f.rpm},
+                        {"dims", f.dims},
+                        {"origin_m", f.origin},
+                        {"spacing_m", f.spacing},
+                        {"points", f.size()},
+                        {"gas_points", gas},
+                        {"gas_fraction", static_cast<double>(gas) / f.size()},
+                        {"max_speed_m_s", umax},
+                        {"midplane_png",
+                         {{"file", "midplane_speed.png"},
+                          {"z_m", 0.0},
+                          {"speed_range_m_s", range},
+                          {"colours", "blue (0) to red (max); grey = solid; bar on the right"}}},
+                        {"files", {"field.h5", "field.vti", "midplane_speed.png"}}};
+  jobs::atomic_write(tmp / "sample_report.json", rep.dump(2) + "\n");
+  fs::remove_all(out);
+  fs::rename(tmp, out);
+  ctx.progress.info(fmt::format(
+      "sample/{}: {}x{}x{} grid at {:g} m, {:.1f}% in the gas, max |U| {:.1f} m/s -> {}", job.label,
+      f.dims[0], f.dims[1], f.dims[2], grid.spacing, 100.0 * gas / f.size(), umax, out.string()));
 }
 
 }  // namespace mill

@@ -1,0 +1,226 @@
+// The calibrate stage end to end with real LIGGGHTS runs: the two virtual lab
+// tests on a tiny specimen, the fitting loop recovering bond parameters that
+// are known to reach a synthetic target, and the ore card's own calibration.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "config/case_config.h"
+#include "stages/material.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kData = MILL_TEST_DATA;
+
+fs::path scratch(const std::string& name) {
+  fs::path d = fs::temp_directory_path() / ("mill_cal_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+// Run orchestrate to completion; returns its exit status, output in `log`.
+int orchestrate(const std::string& args, const fs::path& log) {
+  const std::string cmd = "MILL_LIGGGHTS='" + std::string(LIGGGHTS_MILL_EXE) + "' '" +
+                          ORCHESTRATE_EXE + "' " + args + " > '" + log.string() + "' 2>&1";
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+std::string slurp(const fs::path& f) {
+  std::ifstream in(f);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+void spit(const fs::path& f, const std::string& text) {
+  std::ofstream o(f);
+  o << text;
+}
+
+nlohmann::json read_json(const fs::path& f) { return nlohmann::json::parse(slurp(f)); }
+
+// One tiny calibration (one iteration: both tests once, plus the half-rate
+// UCS) shared by the tests below.
+class TinyCalibration : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(scratch("tiny"));
+    status_ = orchestrate(
+        "--case " + kData + "/tiny_calibrate.yaml --stage calibrate --output " + dir_->string(),
+        *dir_ / "first.log");
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static fs::path* dir_;
+  static int status_;
+};
+fs::path* TinyCalibration::dir_ = nullptr;
+int TinyCalibration::status_ = -1;
+
+TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
+  ASSERT_EQ(status_, 0) << slurp(*dir_ / "first.log");
+  const auto r = read_json(*dir_ / "calibrate" / "report.json");
+  for (const char* k : {"youngs_modulus", "poisson_ratio", "ucs", "tensile_strength"}) {
+    const double v = r["achieved"][k].get<double>();
+    EXPECT_TRUE(std::isfinite(v) && v > 0) << k << " = " << v;
+  }
+  // Plausible orders of magnitude for a sandstone-like bonded packing.
+  EXPECT_GT(r["achieved"]["youngs_modulus"].get<double>(), 1e9);
+  EXPECT_LT(r["achieved"]["poisson_ratio"].get<double>(), 0.5);
+  EXPECT_GT(r["achieved"]["ucs"].get<double>(), r["achieved"]["tensile_strength"].get<double>());
+  EXPECT_EQ(r["specimen"]["ucs_cylinder"]["elements"].get<double>(), 200);
+  EXPECT_EQ(r["specimen"]["brazilian_disc"]["elements"].get<double>(), 200);
+  EXPECT_TRUE(r["rate_check"]["ucs"].get<double>() > 0);
+
+  // Every output, in the format the breakage stage reads.
+  for (const char* f :
+       {"calibrated.yaml", "report.md", "report.json", "curves.csv", "plots/ucs_stress_strain.png",
+        "plots/brazilian_load_displacement.png", "plots/convergence.png"})
+    EXPECT_TRUE(fs::exists(*dir_ / "calibrate" / f)) << f;
+  const YAML::Node y = YAML::LoadFile((*dir_ / "calibrate" / "calibrated.yaml").string());
+  for (const char* k : {"bond_modulus", "stiffness_ratio", "bond_tensile_strength", "bond_cohesion",
+                        "bond_friction_angle", "input_hash"})
+    EXPECT_TRUE(y["calibrated"][k]) << k;
+  const auto cfg = mill::config::load_case(kData + "/tiny_calibrate.yaml", MILL_PROJECT_DIR);
+  EXPECT_EQ(y["calibrated"]["input_hash"].as<std::string>(), mill::ore_hash(cfg.ore));
+  const mill::BondParams b = mill::bond_params_for(cfg, *dir_);
+  EXPECT_NE(b.origin.find("calibrated"), std::string::npos) << b.origin;
+  EXPECT_DOUBLE_EQ(b.modulus, y["calibrated"]["bond_modulus"].as<double>());
+  EXPECT_NE(slurp(*dir_ / "calibrate" / "report.md").find("| E (GPa) |"), std::string::npos);
+
+  // A rerun skips the done job.
+  const int st = orchestrate(
+      "--case " + kData + "/tiny_calibrate.yaml --stage calibrate --output " + dir_->string(),
+      *dir_ / "second.log");
+  EXPECT_EQ(st, 0) << slurp(*dir_ / "second.log");
+  EXPECT_NE(slurp(*dir_ / "second.log").find("1 already done"), std::string::npos)
+      << slurp(*dir_ / "second.log");
+}
+
+// A card whose calibrated.* section does not match its properties (stale
+// input_hash): the fit starts from that section. Used here to start from
+// chosen parameters.
+std::string card(const std::string& name, double E, double nu, double ucs, double tensile,
+                 double Eb, double ratio, double sigma_b, double c) {
+  return fmt::format(
+      "name: {}\ndensity: 2580\nfriction: 0.5\nrestitution: 0.5\nyoungs_modulus: "
+      "{:.9g}\npoisson_ratio: {:.9g}\n"
+      "ucs: {:.9g}\ntensile_strength: {:.9g}\ncalibrated:\n  bond_modulus: {:.9g}\n  "
+      "stiffness_ratio: {:.9g}\n"
+      "  bond_tensile_strength: {:.9g}\n  bond_cohesion: {:.9g}\n  bond_friction_angle: 30\n  "
+      "input_hash: stale\n",
+      name, E, nu, ucs, tensile, Eb, ratio, sigma_b, c);
+}
+
+std::string tiny_case(const fs::path& card_file, int iterations) {
+  return fmt::format(
+      "name: synthetic\nore: {{card: {}}}\nlump: {{n_elements: 150, diameter: 0.02, bond_gap: "
+      "0.2}}\n"
+      "calibrate: {{n_elements: 200, max_iterations: {}, strain_rate: 2.0, seed: 2003, "
+      "rate_check: false}}\nresources: {{np: 1, jobs: 1}}\n",
+      card_file.string(), iterations);
+}
+
+// A synthetic target the loop is known to reach: the macro properties that
+// known micro parameters P* give (one measuring run, started from P*). The
+// fit of a card with exactly those properties then starts from P* with the
+// bond modulus 1.5 x too high and the bond strengths (tensile and cohesion,
+// same ratio) halved, and must come back to them. (The card's E is also the contact modulus of the
+// elements, so P* is chosen to give E close to the card's E in the measuring run.)
+TEST(SyntheticTarget, FitRecoversPerturbedBondModulusAndStrengths) {
+  const double Eb = 16.6e9, ratio = 2.5, sigma_b = 10e6, c = 20e6;
+  const fs::path dir = scratch("synthetic");
+  // Measure with P*: twice, the second time with the card's E (the contact
+  // modulus) set to the E measured the first time.
+  double E_card = 6.4e9;
+  nlohmann::json m;
+  for (int pass = 1; pass <= 2; ++pass) {
+    const fs::path d = dir / ("truth" + std::to_string(pass));
+    fs::create_directories(d);
+    spit(d / "truth.yaml", card("truth", E_card, 0.14, 5e6, 0.5e6, Eb, ratio, sigma_b, c));
+    spit(d / "case.yaml", tiny_case(d / "truth.yaml", 1));
+    ASSERT_EQ(orchestrate("--case " + (d / "case.yaml").string() + " --stage calibrate --output " +
+                              d.string(),
+                          d / "run.log"),
+              0)
+        << slurp(d / "run.log");
+    m = read_json(d / "calibrate" / "report.json");
+    ASSERT_DOUBLE_EQ(m["iterations"][0]["bond"]["bond_modulus"].get<double>(), Eb);
+    E_card = m["achieved"]["youngs_modulus"].get<double>();
+  }
+  const auto& a = m["achieved"];
+
+  fs::create_directories(dir / "fit");
+  spit(dir / "fit" / "target.yaml",
+       card("target", a["youngs_modulus"].get<double>(), a["poisson_ratio"].get<double>(),
+            a["ucs"].get<double>(), a["tensile_strength"].get<double>(), 1.5 * Eb, ratio,
+            0.5 * sigma_b, 0.5 * c));
+  spit(dir / "fit" / "case.yaml", tiny_case(dir / "fit" / "target.yaml", 4));
+  ASSERT_EQ(orchestrate("--case " + (dir / "fit" / "case.yaml").string() +
+                            " --stage calibrate --output " + (dir / "fit").string(),
+                        dir / "fit.log"),
+            0)
+      << slurp(dir / "fit.log");
+  const std::string md = slurp(dir / "fit" / "calibrate" / "report.md");
+  const auto r = read_json(dir / "fit" / "calibrate" / "report.json");
+  EXPECT_DOUBLE_EQ(r["iterations"][0]["bond"]["bond_modulus"].get<double>(), 1.5 * Eb) << md;
+  EXPECT_TRUE(r["within_tolerance"]["youngs_modulus"].get<bool>()) << md;
+  EXPECT_TRUE(r["within_tolerance"]["tensile_strength"].get<bool>()) << md;
+  EXPECT_TRUE(r["within_tolerance"]["poisson_ratio"].get<bool>()) << md;
+  EXPECT_NEAR(r["calibrated"]["bond_modulus"].get<double>() / Eb, 1.0, 0.15) << md;
+  EXPECT_NEAR(r["calibrated"]["bond_tensile_strength"].get<double>() / sigma_b, 1.0, 0.15) << md;
+}
+
+// A card whose calibrated.* section was fitted to its own properties: the
+// stage copies it and runs no lab test.
+TEST(CardCalibration, MatchingCardSectionIsCopiedWithoutFitting) {
+  const fs::path dir = scratch("card");
+  const std::string props =
+      "name: carded\ndensity: 2580\nyoungs_modulus: 18.69e9\npoisson_ratio: 0.18\nucs: 50.0e6\n"
+      "tensile_strength: 5.0e6\n";
+  spit(dir / "carded.yaml", props);
+  spit(dir / "case.yaml", "name: carded\nore: {card: " + (dir / "carded.yaml").string() +
+                              "}\ncalibrate: {n_elements: 100}\nresources: {np: 1, jobs: 1}\n");
+  const auto cfg = mill::config::load_case(dir / "case.yaml", MILL_PROJECT_DIR);
+  const std::string hash = mill::ore_hash(cfg.ore);
+  spit(dir / "carded.yaml", props +
+                                "calibrated:\n  bond_modulus: 5.5e10\n  stiffness_ratio: 3.9\n"
+                                "  bond_tensile_strength: 1.6e8\n  bond_cohesion: 6.0e7\n"
+                                "  bond_friction_angle: 30\n  input_hash: " +
+                                hash + "\n");
+  const int st = orchestrate(
+      "--case " + (dir / "case.yaml").string() + " --stage calibrate --output " + dir.string(),
+      dir / "run.log");
+  ASSERT_EQ(st, 0) << slurp(dir / "run.log");
+  EXPECT_NE(slurp(dir / "run.log").find("no fitting"), std::string::npos) << slurp(dir / "run.log");
+  EXPECT_FALSE(fs::exists(dir / "calibrate" / "jobs" / "calibration" / "specimen"));
+  const YAML::Node y = YAML::LoadFile((dir / "calibrate" / "calibrated.yaml").string());
+  EXPECT_DOUBLE_EQ(y["calibrated"]["bond_modulus"].as<double>(), 5.5e10);
+  EXPECT_EQ(y["calibrated"]["input_hash"].as<std::string>(), hash);
+  EXPECT_EQ(read_json(dir / "calibrate" / "report.json")["source"], "ore card");
+
+  // A changed card (other UCS, stale hash) is fitted again: the plan says so.
+  spit(dir / "carded.yaml",
+       "name: carded\ndensity: 2580\nyoungs_modulus: 18.69e9\npoisson_ratio: 0.18\nucs: 60.0e6\n"
+       "tensile_strength: 5.0e6\ncalibrated:\n  bond_modulus: 5.5e10\n  stiffness_ratio: 3.9\n"
+       "  bond_tensile_strength: 1.6e8\n  bond_cohesion: 6.0e7\n  bond_friction_angle: 30\n"
+       "  input_hash: " +
+           hash + "\n");
+  const int st2 = orchestrate("--case " + (dir / "case.yaml").string() +
+                                  " --stage calibrate --dry-run --output " + dir.string(),
+                              dir / "dry.log");
+  EXPECT_EQ(st2, 0) << slurp(dir / "dry.log");
+  EXPECT_NE(slurp(dir / "dry.log").find("UCS + Brazilian tests"), std::string::npos)
+      << slurp(dir / "dry.log");
+  EXPECT_NE(slurp(dir / "dry.log").find("todo"), std::string::npos) << slurp(dir / "dry.log");
+}
+
+}  // namespace

@@ -1,0 +1,108 @@
+// Solver-log parsing (progress, convergence, divergence) and presets.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "geometry/mill_geometry.h"
+#include "stages/flow_stage.h"
+
+namespace fs = std::filesystem;
+using namespace mill::flow;
+
+namespace {
+
+fs::path write_log(const std::string& name, const std::string& text) {
+  const fs::path f =
+      fs::temp_directory_path() / ("mill_flowlog_" + std::to_string(getpid()) + "_" + name);
+  std::ofstream(f) << text;
+  return f;
+}
+
+const char* kIter =
+    "Time = {T}\n\n"
+    "smoothSolver:  Solving for Ux, Initial residual = {U}, Final residual = 1e-05, No Iterations "
+    "2\n"
+    "smoothSolver:  Solving for Uy, Initial residual = 0.001, Final residual = 1e-05, No "
+    "Iterations 2\n"
+    "GAMG:  Solving for p, Initial residual = {P}, Final residual = 1e-06, No Iterations 3\n"
+    "GAMG:  Solving for p, Initial residual = 1e-09, Final residual = 1e-10, No Iterations 3\n"
+    "ExecutionTime = 1 s  ClockTime = 1 s\n\n";
+
+std::string iter(int t, const std::string& u, const std::string& p) {
+  std::string s = kIter;
+  s.replace(s.find("{T}"), 3, std::to_string(t));
+  s.replace(s.find("{U}"), 3, u);
+  s.replace(s.find("{P}"), 3, p);
+  return s;
+}
+
+}  // namespace
+
+TEST(FlowLog, ConvergedRun) {
+  const auto f =
+      write_log("conv", iter(1, "1", "1") + iter(2, "0.01", "0.02") + iter(3, "5e-05", "8e-05") +
+                            "\nSIMPLE solution converged in 3 iterations\n\nEnd\n");
+  const auto s = parse_solver_log(f);
+  EXPECT_EQ(s.iterations, 3);
+  EXPECT_TRUE(s.converged);
+  EXPECT_FALSE(s.nan);
+  EXPECT_DOUBLE_EQ(s.initial_residual.at("p"), 8e-05)
+      << "the first p solve of the iteration, not the corrector";
+  EXPECT_DOUBLE_EQ(s.initial_residual.at("Ux"), 5e-05);
+  fs::remove(f);
+}
+
+TEST(FlowLog, NanAndFpeAreSeen) {
+  const auto f = write_log(
+      "nan",
+      iter(1, "1", "1") + iter(2, "nan", "-nan") +
+          "#0  Foam::error::printStack(Foam::Ostream&)\n#1  Foam::sigFpe::sigHandler(int)\n");
+  const auto s = parse_solver_log(f);
+  EXPECT_EQ(s.iterations, 2);
+  EXPECT_TRUE(s.nan);
+  EXPECT_TRUE(s.fpe);
+  EXPECT_FALSE(s.converged);
+  fs::remove(f);
+}
+
+TEST(FlowLog, PresetsGrowInResolution) {
+  const auto t = mesh_preset("tiny"), q = mesh_preset("quick"), r = mesh_preset("reference");
+  EXPECT_GT(t.cell, q.cell);
+  EXPECT_GE(q.cell, r.cell);
+  EXPECT_TRUE(r.layers);
+  EXPECT_FALSE(t.layers);
+  EXPECT_THROW(mesh_preset("huge"), std::invalid_argument);
+}
+
+// foam_case/ ships the parameters and surfaces of cases/default.yaml so that
+// its Allrun works by hand. MILL_UPDATE_TEMPLATE=1 rewrites them.
+TEST(FlowTemplate, MatchesTheDefaultCase) {
+  const fs::path project = MILL_PROJECT_DIR;
+  const auto cfg = mill::config::load_case(project / "cases" / "default.yaml", project);
+  const auto preset = mesh_preset(cfg.doc.str("flow.mesh_preset"));
+  const std::string params = case_parameters(cfg.doc, cfg.doc.reals("rotor.rpm").at(0), preset, 1);
+  const fs::path tmpl = project / "foam_case";
+  const auto geo = mill::geometry::MillGeometry::from_config(cfg.doc);
+  if (getenv("MILL_UPDATE_TEMPLATE")) {
+    std::ofstream(tmpl / "system" / "caseParameters") << params;
+    mill::geometry::write_stl_set(geo, tmpl / "constant" / "triSurface");
+  }
+  std::ifstream in(tmpl / "system" / "caseParameters");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_EQ(ss.str(), params)
+      << "foam_case/system/caseParameters is stale: rerun this test with MILL_UPDATE_TEMPLATE=1";
+  const fs::path d = fs::temp_directory_path() / ("mill_tmpl_" + std::to_string(getpid()));
+  const auto set = mill::geometry::write_stl_set(geo, d);
+  for (const auto& f : {set.housing, set.flywheel, set.inlet, set.outlet}) {
+    std::ifstream a(f), b(tmpl / "constant" / "triSurface" / f.filename());
+    std::stringstream sa, sb;
+    sa << a.rdbuf();
+    sb << b.rdbuf();
+    EXPECT_EQ(sa.str(), sb.str()) << f.filename() << " is stale: rerun with MILL_UPDATE_TEMPLATE=1";
+  }
+  fs::remove_all(d);
+}
