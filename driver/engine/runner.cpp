@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstring>
@@ -146,6 +147,17 @@ Result Runner::run(const Command& cmd, const Poll& poll) {
   std::vector<char*> argv;
   for (const auto& s : argv_s) argv.push_back(const_cast<char*>(s.c_str()));
   argv.push_back(nullptr);
+  // Own Open MPI session base per run: concurrent engine runs (jobs, tests)
+  // otherwise race on creating /tmp/ompi.<host>.<uid> and orte_init fails.
+  char ompi_tmpl[] = "/tmp/mill-ompi-XXXXXX";
+  const char* ompi_dir = cmd.env.count("OMPI_MCA_orte_tmpdir_base") ? nullptr : mkdtemp(ompi_tmpl);
+  struct RemoveDir {
+    const char* d;
+    ~RemoveDir() {
+      std::error_code ec;
+      if (d) fs::remove_all(d, ec);
+    }
+  } remove_ompi{ompi_dir};
   // Environment built before fork: the child only calls async-signal-safe functions.
   std::vector<std::string> env_s;
   for (char** e = environ; *e; ++e) {
@@ -153,6 +165,12 @@ Result Runner::run(const Command& cmd, const Poll& poll) {
     if (!cmd.env.count(kv.substr(0, kv.find('=')))) env_s.push_back(kv);
   }
   for (const auto& [k, v] : cmd.env) env_s.push_back(k + "=" + v);
+  if (ompi_dir) {
+    env_s.erase(std::remove_if(env_s.begin(), env_s.end(),
+                               [](const std::string& kv) { return kv.rfind("OMPI_MCA_orte_tmpdir_base=", 0) == 0; }),
+                env_s.end());
+    env_s.push_back(std::string("OMPI_MCA_orte_tmpdir_base=") + ompi_dir);
+  }
   std::vector<char*> envp;
   for (const auto& s : env_s) envp.push_back(const_cast<char*>(s.c_str()));
   envp.push_back(nullptr);

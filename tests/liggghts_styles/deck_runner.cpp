@@ -55,7 +55,9 @@ RunResult run_deck(const std::string &dir, const std::string &deck, int nprocs,
     std::ofstream out(dir + "/in.deck");
     out << deck;
   }
-  std::string cmd = "cd '" + dir + "' && ";
+  // Own Open MPI session base per run: concurrent singletons otherwise race
+  // on creating /tmp/ompi.<host>.<uid> ("File exists", orte_init fails).
+  std::string cmd = "cd '" + dir + "' && mkdir -p ompi && OMPI_MCA_orte_tmpdir_base='" + dir + "/ompi' ";
   if (nprocs > 1) {
     cmd += std::string(MILL_MPIEXEC) + " -np " + std::to_string(nprocs) + " --oversubscribe ";
     if (geteuid() == 0) cmd += "--allow-run-as-root ";
