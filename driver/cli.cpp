@@ -135,7 +135,7 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
       const fs::path out_dir = output.empty() ? fs::path("runs") / fmt::format("impact_v{:g}_a{:g}", imp_velocity, imp_angle)
                                               : fs::path(output);
       RunOptions opts;
-      opts.output = out_dir;
+      opts.output = fs::absolute(out_dir);
       opts.np = np > 0 ? np : static_cast<int>(cfg.doc.integer("resources.np"));
       return run_single_impact(cfg, opts, imp_velocity, imp_angle, imp_repeat, out);
     }
@@ -165,7 +165,8 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
     }
     Invocation inv;
     inv.stages = resolve_stages(stage);
-    inv.opts.output = output.empty() ? fs::path("runs") / cfg.name : fs::path(output);
+    // Absolute: engines and helper scripts run in other working directories.
+    inv.opts.output = fs::absolute(output.empty() ? fs::path("runs") / cfg.name : fs::path(output));
     inv.opts.np = np > 0 ? np : static_cast<int>(cfg.doc.integer("resources.np"));
     inv.opts.jobs = jobs > 0 ? jobs : static_cast<int>(cfg.doc.integer("resources.jobs"));
     inv.opts.force = force;
