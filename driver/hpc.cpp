@@ -16,7 +16,9 @@ std::string quote(const std::string& s) {
   return o + "'";
 }
 
-std::string header(const HpcOptions& o, const std::string& name, const fs::path& logs, int ntasks) {
+// log_pattern: Slurm's file-name pattern, %x_%A_%a (array) or %x_%j (single job).
+std::string header(const HpcOptions& o, const std::string& name, const fs::path& logs, int ntasks,
+                   const char* log_pattern) {
   std::string h = "#!/bin/bash\n";
   h += fmt::format("#SBATCH --job-name={}\n", name);
   h += fmt::format("#SBATCH --ntasks={}\n", ntasks);
@@ -24,7 +26,7 @@ std::string header(const HpcOptions& o, const std::string& name, const fs::path&
   if (!o.partition.empty()) h += fmt::format("#SBATCH --partition={}\n", o.partition);
   if (!o.account.empty()) h += fmt::format("#SBATCH --account={}\n", o.account);
   if (!o.mem.empty()) h += fmt::format("#SBATCH --mem={}\n", o.mem);
-  h += fmt::format("#SBATCH --output={}/%x_%A_%a.out\n", logs.string());
+  h += fmt::format("#SBATCH --output={}/{}.out\n", logs.string(), log_pattern);
   return h;
 }
 }  // namespace
@@ -44,14 +46,14 @@ std::string write_hpc_scripts(const config::CaseConfig& cfg, const HpcOptions& o
   const std::string common = fmt::format("{} --case {} --output {} --stage {}", quote(exe), quote(cfg.file.string()),
                                          quote(out.string()), o.stage);
   const std::string array_name = fmt::format("mill-{}-{}", cfg.name, o.stage);
-  std::string array = header(o, array_name, logs, o.np);
+  std::string array = header(o, array_name, logs, o.np, "%x_%A_%a");
   array += fmt::format("#SBATCH --array=0-{}{}\n", n_tasks - 1, o.max_parallel > 0 ? fmt::format("%{}", o.max_parallel) : "");
   array += "# One array task per job of `orchestrate --stage " + o.stage + " --list-tasks`.\n";
   array += "# A task that finds its job done (same inputs) returns at once: resubmitting is safe.\n";
   array += "set -euo pipefail\n";
   array += fmt::format("exec {} --task \"$SLURM_ARRAY_TASK_ID\" --np {} --jobs 1\n", common, o.np);
 
-  std::string merge = header(o, array_name + "-merge", logs, 1);
+  std::string merge = header(o, array_name + "-merge", logs, 1, "%x_%j");
   merge += "# After every array task succeeded: merge the stage's results and write the report.\n";
   merge += "set -euo pipefail\n";
   merge += fmt::format("{} --jobs 1\n", common);

@@ -15,31 +15,15 @@
 #include "jobs/job_store.h"
 #include "postprocess/breakage_results.h"
 
+#include "e2e_util.h"
+
 namespace fs = std::filesystem;
 
 namespace {
 
+using namespace mill::e2e;
+
 const std::string kData = MILL_TEST_DATA;
-
-fs::path scratch(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("mill_e2e_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-// Run orchestrate to completion; returns its exit status, output in `log`.
-int orchestrate(const std::string& args, const fs::path& log) {
-  const std::string cmd = "MILL_LIGGGHTS='" + std::string(LIGGGHTS_MILL_EXE) + "' '" + ORCHESTRATE_EXE + "' " + args +
-                          " > '" + log.string() + "' 2>&1";
-  const int st = std::system(cmd.c_str());
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-std::string slurp(const fs::path& f) {
-  std::ifstream in(f);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
 
 // One campaign shared by the tests below (3 impacts of a 200-element lump).
 class TinyCampaign : public ::testing::Test {

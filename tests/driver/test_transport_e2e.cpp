@@ -13,9 +13,13 @@
 #include "postprocess/flow_field_io.h"
 #include "postprocess/impact_stats.h"
 
+#include "e2e_util.h"
+
 namespace fs = std::filesystem;
 
 namespace {
+
+using namespace mill::e2e;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -32,26 +36,6 @@ transport: {trajectory_interval: 2.0e-3, vtk_interval: 0.05}
 ore: {card: sandstone}
 resources: {np: 1, jobs: 1}
 )";
-
-fs::path scratch(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("mill_e2e_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-// Run orchestrate to completion; returns its exit status, output in `log`.
-int orchestrate(const std::string& args, const fs::path& log) {
-  const std::string cmd = "MILL_LIGGGHTS='" + std::string(LIGGGHTS_MILL_EXE) + "' '" +
-                          ORCHESTRATE_EXE + "' " + args + " > '" + log.string() + "' 2>&1";
-  const int st = std::system(cmd.c_str());
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-std::string slurp(const fs::path& f) {
-  std::ifstream in(f);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
 
 // Solid-body rotation at a tenth of the rotor speed about the rotor axis plus
 // a 2 m/s downdraft, inside the housing; no gas inside the hub.

@@ -1,0 +1,94 @@
+// Helpers shared by the end-to-end tests that run the real `orchestrate`
+// (with the project's liggghts-mill): scratch folders, running and spawning
+// the program, reading files and job states.
+#pragma once
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "jobs/job_store.h"
+
+namespace mill::e2e {
+
+namespace fs = std::filesystem;
+
+// An empty folder under the temp dir, unique to this process.
+inline fs::path scratch(const std::string& name) {
+  fs::path d = fs::temp_directory_path() / ("mill_e2e_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+inline std::string slurp(const fs::path& f) {
+  std::ifstream in(f);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+inline void spit(const fs::path& f, const std::string& text) {
+  std::ofstream o(f);
+  o << text;
+}
+
+// Runs orchestrate to completion (in `cwd` if given); returns its exit
+// status, its output in `log`.
+inline int orchestrate(const std::string& args, const fs::path& log, const fs::path& cwd = {}) {
+  std::string cmd;
+  if (!cwd.empty()) cmd = "cd '" + cwd.string() + "' && ";
+  cmd += "MILL_LIGGGHTS='" + std::string(LIGGGHTS_MILL_EXE) + "' '" + ORCHESTRATE_EXE + "' " + args + " > '" +
+         log.string() + "' 2>&1";
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+// Starts orchestrate with `args` (one per element) in the background (in
+// `cwd` if given), output in `log`; returns its pid (reap it with finish()).
+inline pid_t spawn_orchestrate(const std::vector<std::string>& args, const fs::path& log, const fs::path& cwd = {}) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    if (!cwd.empty() && chdir(cwd.c_str()) != 0) _exit(126);
+    setenv("MILL_LIGGGHTS", LIGGGHTS_MILL_EXE, 1);
+    if (!freopen(log.c_str(), "w", stdout) || !freopen(log.c_str(), "a", stderr)) _exit(126);
+    std::vector<char*> argv{const_cast<char*>(ORCHESTRATE_EXE)};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(ORCHESTRATE_EXE, argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+// Waits for `pid`; its exit status, 128+N if killed by signal N.
+inline int finish(pid_t pid) {
+  int st = 0;
+  waitpid(pid, &st, 0);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+}
+
+// Polls `ready` every 100 ms for at most `seconds`; true once it holds.
+inline bool wait_for(const std::function<bool()>& ready, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    if (ready()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return ready();
+}
+
+// State of job `label` of the stage whose folder is `stage_dir`.
+inline jobs::State job_state(const fs::path& stage_dir, const std::string& label) {
+  return jobs::JobStore(stage_dir).read_status(label).state;
+}
+
+}  // namespace mill::e2e

@@ -1,0 +1,99 @@
+// The whole workflow with real engines, as README command 1 runs it but on
+// tiny settings: `orchestrate --stage all` from a folder with the default
+// relative run folder (flow on the tiny OpenFOAM mesh, sample, transport,
+// calibrate, breakage at the transport's impact conditions, report), killed
+// with SIGTERM mid-breakage and rerun: the rerun finishes without redoing any
+// job that had finished (checked by the jobs' STATUS modification times).
+#include <gtest/gtest.h>
+
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "e2e_util.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using namespace mill::e2e;
+using mill::jobs::State;
+
+// Every job's STATUS under the run folder: path -> modification time.
+std::map<fs::path, fs::file_time_type> status_times(const fs::path& run) {
+  std::map<fs::path, fs::file_time_type> t;
+  for (const auto& e : fs::recursive_directory_iterator(run))
+    if (e.path().filename() == "STATUS") t[e.path()] = fs::last_write_time(e.path());
+  return t;
+}
+
+// Labels of the breakage jobs in state s.
+std::vector<std::string> breakage_jobs(const fs::path& run, State s) {
+  std::vector<std::string> out;
+  const fs::path stage = run / "breakage", jobs = stage / "jobs";
+  if (!fs::is_directory(jobs)) return out;
+  for (const auto& e : fs::directory_iterator(jobs))
+    if (fs::exists(e.path() / "STATUS") && job_state(stage, e.path().filename().string()) == s)
+      out.push_back(e.path().filename().string());
+  return out;
+}
+
+TEST(WholeWorkflow, StageAllKilledMidBreakageResumesWithoutRedoingJobs) {
+  const fs::path dir = scratch("all");
+  const fs::path run = dir / "runs" / "tiny_all";  // the default, relative run folder
+  const std::vector<std::string> args = {"--case", std::string(MILL_TEST_DATA) + "/tiny_all.yaml", "--stage", "all"};
+
+  // First run: killed once one breakage job is done and the next is running.
+  const pid_t pid = spawn_orchestrate(args, dir / "killed.log", dir);
+  const bool ready = wait_for([&] {
+    return !breakage_jobs(run, State::Done).empty() && !breakage_jobs(run, State::Running).empty();
+  }, 600);
+  if (!ready) kill(pid, SIGKILL);
+  ASSERT_TRUE(ready) << "never saw a breakage job done and another running:\n" << slurp(dir / "killed.log");
+  kill(pid, SIGTERM);
+  ASSERT_EQ(finish(pid), 128 + SIGTERM) << slurp(dir / "killed.log");
+
+  const auto done_before = breakage_jobs(run, State::Done);
+  const auto killed = breakage_jobs(run, State::Failed);
+  ASSERT_EQ(killed.size(), 1u) << "the running job must be marked failed:\n" << slurp(dir / "killed.log");
+  EXPECT_TRUE(breakage_jobs(run, State::Running).empty());
+  EXPECT_FALSE(fs::exists(run / "breakage/jobs" / killed[0] / "summary.csv"));
+  EXPECT_FALSE(fs::exists(run / "report/index.html"));
+  // Stage 1 and the calibration finished before the kill; their STATUS and
+  // that of every finished breakage job must not be written again.
+  std::map<fs::path, fs::file_time_type> finished;
+  for (const auto& [f, t] : status_times(run))
+    if (mill::jobs::JobStore(f.parent_path().parent_path().parent_path())
+            .read_status(f.parent_path().filename().string())
+            .state == State::Done)
+      finished[f] = t;
+  for (const char* stage : {"flow/jobs/rpm2000", "sample/jobs/rpm2000", "transport/jobs/rpm2000",
+                            "calibrate/jobs/calibration"})
+    EXPECT_EQ(finished.count(run / stage / "STATUS"), 1u) << stage << " was not done before the kill";
+
+  // Rerun: finishes, redoes nothing that was done, completes the rest.
+  ASSERT_EQ(orchestrate("--case " + args[1] + " --stage all", dir / "resumed.log", dir), 0) << slurp(dir / "resumed.log");
+  const auto after = status_times(run);
+  for (const auto& [f, t] : finished) {
+    ASSERT_EQ(after.count(f), 1u) << f;
+    EXPECT_EQ(after.at(f), t) << "redone after the kill: " << f;
+  }
+  EXPECT_EQ(breakage_jobs(run, State::Done).size(), 4u) << slurp(dir / "resumed.log");  // 2 bins x 2 repeats
+  EXPECT_NE(slurp(dir / "resumed.log").find("breakage: 4 jobs, " + std::to_string(done_before.size()) + " already done"),
+            std::string::npos)
+      << slurp(dir / "resumed.log");
+
+  // What the stages produced, chained for real.
+  EXPECT_TRUE(fs::exists(run / "sample/rpm2000/field.h5"));  // transport read the sampled CFD field
+  const auto s = nlohmann::json::parse(slurp(run / "transport/rpm2000/summary.json"));
+  EXPECT_EQ(s.at("n_particles").get<int>(), 6);
+  EXPECT_GT(s.at("n_flywheel_impacts").get<int>(), 0);
+  EXPECT_TRUE(fs::exists(run / "transport/rpm2000/plots/trajectories.png"));
+  EXPECT_TRUE(fs::exists(run / "breakage/product.csv"));
+  const std::string html = slurp(run / "report/index.html");
+  EXPECT_NE(html.find("Stage 1b: ore lumps through the mill"), std::string::npos);
+  EXPECT_NE(html.find("sample/rpm2000/"), std::string::npos);
+  const auto summary = nlohmann::json::parse(slurp(run / "report/summary.json"));
+  EXPECT_FALSE(summary.empty());
+}
+
+}  // namespace
