@@ -1,14 +1,6 @@
 // The breakage stage end to end with real LIGGGHTS runs: a tiny campaign's
 // physics trends, resuming, a kill mid-campaign, and `orchestrate impact`.
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <chrono>
-#include <cstdlib>
-#include <fstream>
-#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -97,40 +89,28 @@ TEST_F(TinyCampaign, RerunSkipsDoneJobs) {
 // failed (never done), and a rerun completes without redoing finished jobs.
 TEST(KillResume, KilledCampaignResumes) {
   const fs::path dir = scratch("kill");
-  const std::string args = "--case " + kData + "/tiny_breakage.yaml --stage breakage --jobs 1 --output " + dir.string();
-  pid_t pid = fork();
-  if (pid == 0) {
-    setenv("MILL_LIGGGHTS", LIGGGHTS_MILL_EXE, 1);
-    const std::string log = (dir / "killed.log").string();
-    freopen(log.c_str(), "w", stdout);
-    freopen(log.c_str(), "a", stderr);
-    execl(ORCHESTRATE_EXE, ORCHESTRATE_EXE, "--case", (kData + "/tiny_breakage.yaml").c_str(), "--stage", "breakage",
-          "--jobs", "1", "--output", dir.c_str(), static_cast<char*>(nullptr));
-    _exit(127);
-  }
+  const std::vector<std::string> args = {"--case", kData + "/tiny_breakage.yaml", "--stage", "breakage", "--jobs", "1",
+                                         "--output", dir.string()};
+  const pid_t pid = spawn_orchestrate(args, dir / "killed.log");
   // Wait until the first job is done and the second is running, then kill.
-  const fs::path first = dir / "breakage/jobs/v1_a90_r0/STATUS", second = dir / "breakage/jobs/v20_a90_r0/STATUS";
-  auto state = [](const fs::path& f) { return mill::jobs::JobStore(f.parent_path().parent_path().parent_path())
-                                                  .read_status(f.parent_path().filename().string()).state; };
-  bool ready = false;
-  for (int i = 0; i < 1200 && !ready; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    ready = fs::exists(first) && state(first) == mill::jobs::State::Done && fs::exists(second) &&
-            state(second) == mill::jobs::State::Running;
-  }
+  const fs::path stage = dir / "breakage", first = stage / "jobs/v1_a90_r0/STATUS";
+  const bool ready = wait_for([&] {
+    return job_state(stage, "v1_a90_r0") == mill::jobs::State::Done &&
+           job_state(stage, "v20_a90_r0") == mill::jobs::State::Running;
+  }, 120);
+  if (!ready) kill(pid, SIGKILL);
   ASSERT_TRUE(ready) << slurp(dir / "killed.log");
   kill(pid, SIGTERM);
-  int st = 0;
-  waitpid(pid, &st, 0);
-  ASSERT_TRUE(WIFEXITED(st));
-  EXPECT_EQ(WEXITSTATUS(st), 128 + SIGTERM) << slurp(dir / "killed.log");
-  EXPECT_EQ(state(second), mill::jobs::State::Failed);
-  EXPECT_FALSE(fs::exists(dir / "breakage/jobs/v20_a90_r0/summary.csv"));
+  EXPECT_EQ(finish(pid), 128 + SIGTERM) << slurp(dir / "killed.log");
+  EXPECT_EQ(job_state(stage, "v20_a90_r0"), mill::jobs::State::Failed);
+  EXPECT_FALSE(fs::exists(stage / "jobs/v20_a90_r0/summary.csv"));
   const auto t_first = fs::last_write_time(first);
 
-  EXPECT_EQ(orchestrate(args, dir / "resumed.log"), 0) << slurp(dir / "resumed.log");
+  std::string line;
+  for (const auto& a : args) line += "'" + a + "' ";
+  EXPECT_EQ(orchestrate(line, dir / "resumed.log"), 0) << slurp(dir / "resumed.log");
   EXPECT_EQ(fs::last_write_time(first), t_first) << "the finished job was redone";
-  EXPECT_EQ(mill::post::ReadSummaryCsv((dir / "breakage/summary.csv").string()).size(), 3u);
+  EXPECT_EQ(mill::post::ReadSummaryCsv((stage / "summary.csv").string()).size(), 3u);
 }
 
 TEST(ImpactCommand, WritesOneRowInItsFolder) {
