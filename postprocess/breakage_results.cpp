@@ -433,11 +433,64 @@ void AppendFractionsCsv(const std::string& path, const ImpactResult& result) {
   const ImpactSummary& s = result.summary;
   std::vector<std::string> rows;
   for (std::size_t k = 0; k < result.fraction_mass.size(); ++k) {
-    rows.push_back(fmt::format("{},{},{},{},{},{},{}", s.velocity_m_s, s.angle_deg, s.repeat, k,
-                               result.fraction_edges[k], result.fraction_edges[k + 1],
-                               result.fraction_mass[k]));
+    rows.push_back(FractionsCsvLine({{s.velocity_m_s, s.angle_deg, s.repeat},
+                                     static_cast<int>(k),
+                                     result.fraction_edges[k],
+                                     result.fraction_edges[k + 1],
+                                     result.fraction_mass[k]}));
   }
   AppendCsvRows(path, JoinCsv(FractionsCsvColumns()), rows);
+}
+
+// One fractions.csv line.
+std::string FractionsCsvLine(const FractionRow& r) {
+  return fmt::format("{},{},{},{},{},{},{}", r.conditions.velocity_m_s, r.conditions.angle_deg,
+                     r.conditions.repeat, r.index, r.d_low_rel, r.d_high_rel, r.mass_fraction);
+}
+
+// fractions.csv back into rows.
+std::vector<FractionRow> ReadFractionsCsv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw PostError(fmt::format("{}: cannot open fractions file", path));
+  std::string line;
+  if (!std::getline(in, line)) throw PostError(fmt::format("{}: empty, expected a header", path));
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (SplitCsv(line) != FractionsCsvColumns()) {
+    throw PostError(fmt::format("{}:1: header '{}', expected '{}'", path, line,
+                                JoinCsv(FractionsCsvColumns())));
+  }
+  const auto& names = FractionsCsvColumns();
+  std::vector<FractionRow> rows;
+  long line_no = 1;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const auto cells = SplitCsv(line);
+    if (cells.size() != names.size()) {
+      throw PostError(fmt::format("{}:{}: {} values, header has {}", path, line_no, cells.size(),
+                                  names.size()));
+    }
+    double v[7];
+    for (std::size_t c = 0; c < names.size(); ++c) {
+      std::size_t used = 0;
+      try {
+        v[c] = std::stod(cells[c], &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != cells[c].size()) {
+        throw PostError(fmt::format("{}:{}: {}: expected a number, got '{}'", path, line_no,
+                                    names[c], cells[c]));
+      }
+    }
+    if (v[3] < 0 || v[3] != static_cast<int>(v[3])) {
+      throw PostError(fmt::format("{}:{}: fraction_index: expected a whole number >= 0, got '{}'",
+                                  path, line_no, cells[3]));
+    }
+    rows.push_back({{v[0], v[1], static_cast<int>(v[2])}, static_cast<int>(v[3]), v[4], v[5], v[6]});
+  }
+  return rows;
 }
 
 // summary.csv back into structs.

@@ -89,6 +89,22 @@ void AppendFractionsCsv(const std::string& path, const ImpactResult& result);
 // Reads summary.csv back; columns by name, the required ones must be present.
 std::vector<ImpactSummary> ReadSummaryCsv(const std::string& path);
 
+// One row of fractions.csv: the mass fraction of one size fraction of one impact.
+struct FractionRow {
+  ImpactConditions conditions;
+  int index = 0;             // fraction index, 0 = finest
+  double d_low_rel = 0.0;    // lower edge, d/D
+  double d_high_rel = 0.0;   // upper edge, d/D
+  double mass_fraction = 0.0;
+};
+
+// Reads fractions.csv back. The header must be FractionsCsvColumns(); throws
+// PostError naming file, line and column on anything else.
+std::vector<FractionRow> ReadFractionsCsv(const std::string& path);
+
+// One fractions.csv line (no newline), formatted as AppendFractionsCsv does.
+std::string FractionsCsvLine(const FractionRow& row);
+
 // The HDF5 group name of an impact, e.g. "v150.0_a90_r0".
 std::string ImpactGroupName(const ImpactConditions& c);
 

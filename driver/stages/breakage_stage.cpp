@@ -284,18 +284,12 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& jobs
     const fs::path jd = store.job_dir(j.label);
     h5.push_back((jd / "impact.h5").string());
     for (const auto& s : post::ReadSummaryCsv((jd / "summary.csv").string())) rows.push_back(s);
-    std::ifstream in(jd / "fractions.csv");
-    std::string line;
-    bool header = true;
-    while (std::getline(in, line)) {
-      if (header) {
-        if (fractions_text.empty()) fractions_text = line + "\n";
-        header = false;
-        continue;
-      }
-      fractions_text += line + "\n";
-    }
+    for (const auto& f : post::ReadFractionsCsv((jd / "fractions.csv").string()))
+      fractions_text += post::FractionsCsvLine(f) + "\n";
   }
+  std::string header;
+  for (const auto& c : post::FractionsCsvColumns()) header += (header.empty() ? "" : ",") + c;
+  fractions_text = header + "\n" + fractions_text;
   const fs::path stmp = dir / "summary.csv.part";
   fs::remove(stmp);
   for (const auto& s : rows) post::AppendSummaryCsv(stmp.string(), s);
@@ -355,16 +349,11 @@ void BreakageStage::write_mill_product(StageContext& ctx, const std::vector<JobS
     const auto rows = post::ReadSummaryCsv((jd / "summary.csv").string());
     if (rows.empty()) throw std::runtime_error((jd / "summary.csv").string() + ": no row");
     std::vector<double> frac(edges.size() - 1, 0.0);
-    std::ifstream in(jd / "fractions.csv");
-    std::string line;
-    std::getline(in, line);
-    while (std::getline(in, line)) {
-      std::vector<std::string> cells;
-      std::stringstream ss(line);
-      for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
-      if (cells.size() < 7) continue;
-      const size_t k = std::stoul(cells[3]);
-      if (k < frac.size()) frac[k] = std::stod(cells[6]);
+    for (const auto& f : post::ReadFractionsCsv((jd / "fractions.csv").string())) {
+      if (f.index >= static_cast<int>(frac.size()))
+        throw std::runtime_error(fmt::format("{}: fraction {} beyond the case's {} size fractions",
+                                             (jd / "fractions.csv").string(), f.index, frac.size()));
+      frac[f.index] = f.mass_fraction;
     }
     Acc& a = by_rpm[j.inputs.at("rpm").get<double>()][j.inputs.at("bin").get<int>()];
     a.c.weight = j.inputs.at("weight").get<double>();

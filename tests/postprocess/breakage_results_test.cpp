@@ -131,6 +131,51 @@ TEST(FractionsCsv, OneRowPerFractionSummingToOne) {
   EXPECT_NEAR(std::accumulate(r.fraction_mass.begin(), r.fraction_mass.end(), 0.0), 1.0, 1e-14);
 }
 
+TEST(FractionsCsv, ReadsBackWhatWasWritten) {
+  const auto dir = TestDir();
+  const std::string path = (dir / "fractions.csv").string();
+  const auto a = MakeImpact(60.0, 0), b = MakeImpact(150.0, 1, 12, 2);
+  AppendFractionsCsv(path, a);
+  AppendFractionsCsv(path, b);
+  const auto rows = ReadFractionsCsv(path);
+  ASSERT_EQ(rows.size(), 2 * a.fraction_mass.size());
+  for (std::size_t k = 0; k < a.fraction_mass.size(); ++k) {
+    const auto& r = rows[a.fraction_mass.size() + k];
+    EXPECT_DOUBLE_EQ(r.conditions.velocity_m_s, 150.0);
+    EXPECT_EQ(r.conditions.repeat, 1);
+    EXPECT_EQ(r.index, static_cast<int>(k));
+    EXPECT_DOUBLE_EQ(r.d_low_rel, b.fraction_edges[k]);
+    EXPECT_DOUBLE_EQ(r.d_high_rel, b.fraction_edges[k + 1]);
+    EXPECT_DOUBLE_EQ(r.mass_fraction, b.fraction_mass[k]);  // shortest round-trip format: exact
+  }
+  std::ifstream in(path);
+  std::string header, line1;
+  std::getline(in, header);
+  std::getline(in, line1);
+  EXPECT_EQ(FractionsCsvLine(rows[0]), line1);
+}
+
+TEST(FractionsCsv, BadFilesAreNamedWithLineAndColumn) {
+  const auto dir = TestDir();
+  const std::string path = (dir / "fractions.csv").string();
+  auto message = [&](const std::string& text) {
+    std::ofstream(path) << text;
+    try {
+      ReadFractionsCsv(path);
+    } catch (const PostError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string header = "velocity_m_s,angle_deg,repeat,fraction_index,d_low_rel,d_high_rel,mass_fraction\n";
+  EXPECT_NE(message("a,b\n").find("fractions.csv:1: header"), std::string::npos);
+  EXPECT_NE(message(header + "1,90,0,0,0,0.05,x\n").find("fractions.csv:2: mass_fraction: expected a number"),
+            std::string::npos);
+  EXPECT_NE(message(header + "1,90,0,1.5,0,0.05,0\n").find("fraction_index"), std::string::npos);
+  EXPECT_NE(message(header + "1,90,0\n").find("fractions.csv:2: 3 values"), std::string::npos);
+  EXPECT_NE(message("").find("empty"), std::string::npos);
+}
+
 TEST(Impact, T10FlagWhenElementsAreCoarserThanTenthOfD) {
   // Ten equal elements: the lump's solid is 10 element volumes, so one element
   // has d/D_solid = 10^(-1/3) = 0.464, coarser than D/10.
