@@ -392,6 +392,15 @@ void BreakageStage::write_mill_product(StageContext& ctx, const std::vector<JobS
   }
   jobs::atomic_write(dir / "product.csv", csv);
   jobs::atomic_write(dir / "product.json", out.dump(2) + "\n");
+
+  // The product against rotor speed (matplotlib, Debian's python3).
+  engine::Command c;
+  c.argv = {"/usr/bin/python3", (ctx.cfg.project_dir / "postprocess" / "plot_product.py").string(), "--product",
+            (dir / "product.json").string(), "--out", (dir / "plots").string()};
+  c.cwd = dir;
+  c.log = dir / "plot_product.log";
+  c.job = "breakage/product plot";
+  ctx.runner.run(c);
 }
 
 }  // namespace mill

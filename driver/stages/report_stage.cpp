@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "engine/runner.h"
 #include "jobs/job_store.h"
 #include "postprocess/breakage_results.h"
 #include "progress.h"
@@ -94,6 +95,77 @@ void json_table(std::ostringstream& o, const nlohmann::json& j, const std::strin
   if (prefix.empty()) o << "</table>\n";
 }
 
+// A JSON file, or null when it does not exist or does not parse.
+nlohmann::json read_json(const fs::path& f) {
+  if (!fs::exists(f)) return nullptr;
+  try {
+    return nlohmann::json::parse(slurp(f));
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+}
+
+// v[key] or null.
+nlohmann::json pick(const nlohmann::json& v, const char* key) {
+  return v.is_object() && v.contains(key) ? v.at(key) : nlohmann::json(nullptr);
+}
+
+void embed_png(std::ostringstream& o, const fs::path& f, const std::string& caption) {
+  o << "<figure><img alt=\"" << esc(caption) << "\" src=\"data:image/png;base64," << base64(slurp(f))
+    << "\"><figcaption>" << esc(caption) << "</figcaption></figure>\n";
+}
+
+// The numbers an engineer looks at first, per stage (and per rotor speed).
+nlohmann::json headline(const fs::path& run) {
+  nlohmann::json h = nlohmann::json::object();
+  for (const auto& d : {run / "flow", run / "transport"}) {
+    if (!fs::is_directory(d)) continue;
+    for (const auto& e : fs::directory_iterator(d)) {
+      const std::string rpm = e.path().filename().string();
+      if (!e.is_directory() || rpm.rfind("rpm", 0) != 0) continue;
+      if (d.filename() == "flow") {
+        const auto f = read_json(e.path() / "flow_report.json");
+        if (f.is_null()) continue;
+        h["flow"][rpm] = {{"cells", pick(f, "cells")},
+                          {"iterations", pick(f, "iterations")},
+                          {"converged", pick(f, "converged")},
+                          {"mass_imbalance_relative", pick(pick(f, "mass_flow_kg_s"), "imbalance_relative")},
+                          {"inlet_mass_flow_kg_s", pick(pick(f, "mass_flow_kg_s"), "inlet_in")},
+                          {"rim_gas_speed_to_tip_speed", pick(pick(f, "rim"), "ratio_speed_to_tip_speed")}};
+      } else {
+        const auto t = read_json(e.path() / "summary.json");
+        if (t.is_null()) continue;
+        h["transport"][rpm] = {{"lumps", pick(t, "n_particles")},
+                               {"flywheel_impacts", pick(t, "n_flywheel_impacts")},
+                               {"wall_impacts", pick(t, "n_wall_impacts")},
+                               {"flywheel_impact_speed_mean_m_s", pick(t, "flywheel_impact_speed_mean_m_s")},
+                               {"flywheel_normal_speed_mean_m_s", pick(t, "flywheel_normal_speed_mean_m_s")},
+                               {"flywheel_angle_mean_deg", pick(t, "flywheel_angle_mean_deg")}};
+      }
+    }
+  }
+  const auto cal = read_json(run / "calibrate" / "report.json");
+  if (!cal.is_null())
+    h["calibration"] = {{"source", pick(cal, "source")}, {"converged", pick(cal, "converged")},
+                        {"achieved", pick(cal, "achieved")}};
+  const auto crit = read_json(run / "breakage" / "critical_velocity.json");
+  if (crit.is_array()) {
+    for (const auto& c : crit)
+      h["breakage"]["critical_velocity_m_s"][fmt::format("{:g} deg", pick(c, "angle_deg").get<double>())] =
+          pick(c, "critical_velocity_m_s");
+    h["breakage"]["critical_largest_fraction"] = crit.empty() ? nlohmann::json(nullptr) : pick(crit[0], "threshold");
+  }
+  const auto prod = read_json(run / "breakage" / "product.json");
+  if (prod.is_array())
+    for (const auto& p : prod)
+      h["product"][fmt::format("rpm{:g}", pick(p, "rpm").get<double>())] = {
+          {"fully_shredded_mass_fraction", pick(p, "fully_shredded_mass_fraction")},
+          {"largest_piece_mass_fraction", pick(p, "largest_piece_mass_fraction")},
+          {"t10_percent", pick(p, "t10_percent")},
+          {"conditions", pick(p, "conditions")}};
+  return h;
+}
+
 }  // namespace
 
 Plan ReportStage::plan(const StageContext& ctx) const {
@@ -106,7 +178,7 @@ Plan ReportStage::plan(const StageContext& ctx) const {
     in.push_back({fs::relative(f, ctx.run_dir).string(), static_cast<long long>(st.st_size),
                   static_cast<long long>(st.st_mtime)});
   }
-  p.jobs.push_back({"report", {{"inputs", in}, {"report_version", 1}},
+  p.jobs.push_back({"report", {{"inputs", in}, {"report_version", 2}},
                     "report/index.html and report/summary.json from every stage's outputs"});
   return p;
 }
@@ -114,7 +186,23 @@ Plan ReportStage::plan(const StageContext& ctx) const {
 void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
   const fs::path run = ctx.run_dir, out_dir = ctx.stage_dir;
   const auto inputs = report_inputs(run);
-  nlohmann::json summary = {{"case", ctx.cfg.name}, {"ore", ctx.cfg.ore.str("name")}};
+  nlohmann::json summary = {{"case", ctx.cfg.name}, {"ore", ctx.cfg.ore.str("name")}, {"headline", headline(run)}};
+
+  // Figures drawn for the report from the flow stage's files: the mill
+  // geometry and the solver's convergence (matplotlib, Debian's python3).
+  const fs::path figures = out_dir / "figures";
+  fs::remove_all(figures);
+  if (fs::is_directory(run / "flow")) {
+    fs::create_directories(figures);
+    engine::Command c;
+    c.argv = {"/usr/bin/python3", (ctx.cfg.project_dir / "postprocess" / "plot_report_figures.py").string(), "--run",
+              run.string(), "--out", figures.string(), "--target",
+              fmt::format("{:g}", ctx.cfg.doc.real("flow.residual_target"))};
+    c.cwd = out_dir;
+    c.log = out_dir / "figures.log";
+    c.job = "report/figures";
+    ctx.runner.run(c);
+  }
   std::ostringstream o;
   o << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>Beater mill: " << esc(ctx.cfg.name)
     << "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
@@ -126,7 +214,12 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
   o << "<p class=note>Case file <code>" << esc(ctx.cfg.file.string()) << "</code>, ore card <code>"
     << esc(ctx.cfg.ore_file.string()) << "</code>. Every figure is embedded; its data file is linked.</p>\n";
 
+  o << "<h2>Headline numbers</h2>\n";
+  if (summary["headline"].empty()) o << "<p class=note>No stage has produced results yet.</p>\n";
+  else json_table(o, summary["headline"]);
+
   o << "<h2>Case and ore card</h2>\n";
+  if (fs::exists(figures / "mill_geometry.png")) embed_png(o, figures / "mill_geometry.png", "mill geometry (STL)");
   json_table(o, ctx.cfg.ore.to_json());
   o << "<details><summary>All case keys (defaults included)</summary>\n";
   json_table(o, ctx.cfg.doc.to_json());
@@ -143,6 +236,10 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
     for (const auto& f : inputs)
       if (fs::relative(f, run).begin()->string() == stage) mine.push_back(f);
     o << "<h2>" << esc(title) << "</h2>\n";
+    if (stage == "flow" && fs::is_directory(figures))
+      for (const auto& f : fs::directory_iterator(figures))
+        if (f.path().filename().string().rfind("flow_convergence_", 0) == 0)
+          embed_png(o, f.path(), "solver convergence, " + f.path().stem().string().substr(17));
     if (mine.empty()) {
       o << "<p class=note>No results: stage '" << stage << "' has not run (<code>orchestrate --stage " << stage
         << "</code>).</p>\n";
@@ -165,8 +262,7 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
             if (e.is_object()) json_table(o, e);
         summary[name] = j;
       } else if (f.extension() == ".png") {
-        o << "<figure><img alt=\"" << esc(name) << "\" src=\"data:image/png;base64," << base64(slurp(f))
-          << "\"><figcaption>" << esc(name) << "</figcaption></figure>\n";
+        embed_png(o, f, name);
       } else if (f.extension() == ".csv" || f.extension() == ".md") {
         o << "<p>Data: <a href=\"" << esc(rel) << "\">" << esc(name) << "</a></p>\n";
       }

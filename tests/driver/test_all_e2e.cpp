@@ -92,8 +92,21 @@ TEST(WholeWorkflow, StageAllKilledMidBreakageResumesWithoutRedoingJobs) {
   const std::string html = slurp(run / "report/index.html");
   EXPECT_NE(html.find("Stage 1b: ore lumps through the mill"), std::string::npos);
   EXPECT_NE(html.find("sample/rpm2000/"), std::string::npos);
-  const auto summary = nlohmann::json::parse(slurp(run / "report/summary.json"));
-  EXPECT_FALSE(summary.empty());
+  EXPECT_TRUE(fs::exists(run / "breakage/plots/product_vs_rpm.png"));
+  EXPECT_TRUE(fs::exists(run / "report/figures/mill_geometry.png"));
+  EXPECT_TRUE(fs::exists(run / "report/figures/flow_convergence_rpm2000.png"));
+  EXPECT_NE(html.find("mill geometry (STL)"), std::string::npos);
+  EXPECT_NE(html.find("breakage/plots/product_vs_rpm.png"), std::string::npos);
+  // Headline numbers, one entry per stage that ran.
+  const auto h = nlohmann::json::parse(slurp(run / "report/summary.json")).at("headline");
+  EXPECT_EQ(h.at("flow").at("rpm2000").at("iterations").get<int>(), 30);
+  EXPECT_EQ(h.at("transport").at("rpm2000").at("lumps").get<int>(), 6);
+  EXPECT_TRUE(h.at("calibration").contains("achieved"));
+  const auto& prod = h.at("product").at("rpm2000");
+  EXPECT_EQ(prod.at("conditions").get<int>(), 2);
+  const double shredded = prod.at("fully_shredded_mass_fraction").get<double>();
+  EXPECT_GE(shredded, 0.0);
+  EXPECT_LE(shredded, 1.0);
 }
 
 }  // namespace

@@ -1,0 +1,94 @@
+#!/usr/bin/python3
+"""The mill product against rotor speed, from breakage/product.json.
+
+product.json (written by the breakage stage when its conditions come from the
+transport stage) holds, per rotor speed, the product of one pass: the mass per
+size fraction of relative piece size d/D, the fully shredded (single-element)
+mass share, the largest piece and t10. This draws product_vs_rpm.png:
+
+  left   fully shredded mass %, largest piece % and t10 % against rpm: where
+         these flatten, the rotor speed can be lowered for the same product
+  right  the cumulative product distribution (mass % finer than d/D) per rpm
+
+Usage: plot_product.py --product breakage/product.json --out breakage/plots
+"""
+
+import argparse
+import json
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+NEEDED = ("rpm", "fraction_edges_rel", "fraction_mass", "fully_shredded_mass_fraction",
+          "largest_piece_mass_fraction", "t10_percent")
+
+
+def read_product(path):
+    try:
+        with open(path) as f:
+            data = json.load(f)
+    except OSError as e:
+        sys.exit(f"{path}: cannot read ({e.strerror})")
+    except json.JSONDecodeError as e:
+        sys.exit(f"{path}:{e.lineno}: not JSON ({e.msg})")
+    if not isinstance(data, list) or not data:
+        sys.exit(f"{path}: expected a non-empty list of per-rpm products")
+    for i, e in enumerate(data):
+        missing = [k for k in NEEDED if k not in e]
+        if missing:
+            sys.exit(f"{path}: entry {i} lacks {', '.join(missing)}")
+        if len(e["fraction_edges_rel"]) != len(e["fraction_mass"]) + 1:
+            sys.exit(f"{path}: entry {i}: {len(e['fraction_edges_rel'])} edges for "
+                     f"{len(e['fraction_mass'])} fractions")
+    return sorted(data, key=lambda e: e["rpm"])
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--product", required=True, help="breakage/product.json")
+    p.add_argument("--out", required=True, help="folder for product_vs_rpm.png")
+    a = p.parse_args(argv)
+    data = read_product(a.product)
+    os.makedirs(a.out, exist_ok=True)
+
+    rpm = np.array([e["rpm"] for e in data])
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.3))
+    for key, label, scale in (("fully_shredded_mass_fraction", "fully shredded mass", 100),
+                              ("largest_piece_mass_fraction", "largest piece", 100),
+                              ("t10_percent", "t10 (finer than D/10)", 1)):
+        ax1.plot(rpm, [scale * e[key] for e in data], "o-", label=label)
+    ax1.set_xlabel("rotor speed [rpm]")
+    ax1.set_ylabel("% of the feed mass")
+    ax1.set_ylim(-2, 102)
+    if len(rpm) == 1:
+        ax1.set_xlim(rpm[0] * 0.8, rpm[0] * 1.2)
+    ax1.set_title("One pass through the mill")
+    ax1.legend(fontsize=8)
+    ax1.grid(alpha=0.3)
+
+    for e in data:
+        edges = np.array(e["fraction_edges_rel"])
+        cum = np.concatenate([[0.0], np.cumsum(e["fraction_mass"])]) * 100
+        ax2.plot(edges, cum, "o-", ms=3, label=f"{e['rpm']:g} rpm")
+    ax2.set_xlabel("relative piece size d/D")
+    ax2.set_ylabel("mass % finer than d/D")
+    ax2.set_ylim(-2, 102)
+    ax2.set_title("Product size distribution")
+    ax2.legend(fontsize=8)
+    ax2.grid(alpha=0.3)
+    fig.tight_layout()
+    path = os.path.join(a.out, "product_vs_rpm.png")
+    fig.savefig(path + ".tmp", dpi=110, format="png")
+    plt.close(fig)
+    os.replace(path + ".tmp", path)
+    print(path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
