@@ -12,6 +12,7 @@
 #include <vtkPNGWriter.h>
 #include <vtkPointData.h>
 #include <vtkResampleToImage.h>
+#include <vtkSMPTools.h>
 #include <vtkSmartPointer.h>
 #include <vtkUnsignedCharArray.h>
 #include <vtkXMLImageDataWriter.h>
@@ -109,6 +110,11 @@ post::FlowField resample_case(const fs::path& case_dir, const GridSpec& grid, co
                        : 0.0;
 
   post::FlowField f = make_grid(grid);
+  // Probe on one thread: with VTK's threaded backend each thread keeps its own
+  // cell-search hint, so a grid point on a face shared by two cells took the
+  // value of either cell depending on thread timing (runs differed by up to
+  // 0.4 m/s on the tiny mesh, and the transport stage amplified it).
+  vtkSMPTools::SetBackend("Sequential");
   auto rs = Ptr<vtkResampleToImage>::New();
   rs->SetInputConnection(reader->GetOutputPort());
   rs->SetUseInputBounds(false);
