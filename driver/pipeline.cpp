@@ -195,6 +195,13 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
       }
     };
     const int n_threads = std::max(1, std::min<int>(inv.opts.jobs, static_cast<int>(todo.size())));
+    // MPI ranks that wait for each other on shared cores burn CPU in the
+    // wait: 2 jobs x 2 ranks on 2 cores cost ~3x the CPU of 1 rank per job.
+    const unsigned cores = std::thread::hardware_concurrency();
+    if (n_threads > 1 && cores > 0 && static_cast<unsigned>(n_threads * inv.opts.np) > cores)
+      out << fmt::format("warning: {} jobs x {} MPI ranks = {} processes on {} cores: oversubscribed, every run slows "
+                         "down; prefer --np 1 --jobs {} here (resources.np / resources.jobs)\n",
+                         n_threads, inv.opts.np, n_threads * inv.opts.np, cores, cores);
     std::vector<std::thread> pool;
     for (int t = 0; t < n_threads; ++t) pool.emplace_back(worker);
     for (auto& t : pool) t.join();

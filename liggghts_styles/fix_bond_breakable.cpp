@@ -47,7 +47,7 @@ inline double norm3(const double *a) { return std::sqrt(dot3(a, a)); }
 // PFC manual, "contact force update"). |v| is kept exactly; the spin uses the
 // second-order rotation v cos(theta) + (n x v) sin(theta) with
 // cos ~ 1 - theta^2/2, sin ~ theta (theta = spin x dt << 1 for a stable dt).
-void rotate_onto_plane(double *v, const double *n, double theta) {
+[[gnu::always_inline]] inline void rotate_onto_plane(double *v, const double *n, double theta) {
   const double mag0_sq = dot3(v, v);
   if (mag0_sq < 1e-200) {  // |v| < 1e-100: flush, denormal arithmetic is ~100x slower
     v[0] = v[1] = v[2] = 0.0;
@@ -290,6 +290,7 @@ void FixBondBreakable::setup(int /*vflag*/) {
     create_bonds();
     bonds_created_ = 1;
   }
+  list_valid_ = false;  // atoms may have moved between runs
   estimate_time_step();
   compute_bonds(false);
 }
@@ -475,8 +476,10 @@ void FixBondBreakable::remove_slot(int i, int k) {
 // Evaluates the bond between atoms a (lower tag) and b in the canonical frame:
 // advances the history in hist when advance is true, then returns forces,
 // torques, stresses and the breakage verdict.
-void FixBondBreakable::evaluate_bond(const AtomArrays &at, int a, int b, double *hist, bool advance,
+void FixBondBreakable::evaluate_bond(const AtomArrays &at, const ListedBond &bond, bool advance,
                                      BondResult &out) const {
+  const int a = bond.a, b = bond.b;
+  double *hist = bond.hist;
   // Inputs copied to locals first: the stores below then cannot alias them.
   const double xa[3] = {at.x[a][0], at.x[a][1], at.x[a][2]};
   const double d[3] = {at.x[b][0] - xa[0], at.x[b][1] - xa[1], at.x[b][2] - xa[2]};
@@ -494,18 +497,10 @@ void FixBondBreakable::evaluate_bond(const AtomArrays &at, int a, int b, double 
   const double inv_len = 1.0 / len;
   const double n[3] = {d[0] * inv_len, d[1] * inv_len, d[2] * inv_len};
 
-  // Potyondy & Cundall 2004, eq. 5: parallel-bond disc of radius lambda min(Ri,Rj),
-  // A = pi R^2, I = pi R^4 / 4, J = 2 I.
-  const double rbond = radius_multiplier_ * std::min(ra_s, rb_s);
-  const double area = kPi * rbond * rbond;
-  const double inertia = 0.25 * area * rbond * rbond;
-  const double polar = 2.0 * inertia;
-  const double inv_area = 1.0 / area;
-  const double inv_inertia = 4.0 * kPi * inv_area * inv_area;  // = 1 / (pi R^4 / 4)
-  // Stiffness per unit area from the bond modulus over the initial length,
-  // kn = E_b / L0, ks = kn / (kn/ks)  (Potyondy & Cundall 2004, sec. 2.2).
-  const double kn = modulus_ / l0;    // [Pa/m]
-  const double ks = kn * inv_ratio_;  // [Pa/m]
+  // Bond geometry and stiffness (P&C 2004, eq. 5 and sec. 2.2), see build_bond_list.
+  const double rbond = bond.rbond, area = bond.area, inertia = bond.inertia, polar = bond.polar;
+  const double inv_area = bond.inv_area, inv_inertia = bond.inv_inertia;
+  const double kn = bond.kn, ks = bond.ks;
 
   // Contact point on the line of centres (Ra : Rb split): a rigid rotation of
   // the pair then gives no relative motion there (objective shear increment).
@@ -599,20 +594,25 @@ void FixBondBreakable::evaluate_bond(const AtomArrays &at, int a, int b, double 
   }
 }
 
-// Loops over the bonds of owned atoms: advances (if advance), breaks, applies
-// forces, then does this step's single reduction of the global counters.
-void FixBondBreakable::compute_bonds(bool advance) {
-  double **f = atom->f, **torque = atom->torque;
+// True while the cached bond list still matches the atom arrays: no
+// neighbour-list build (the only time LIGGGHTS exchanges, sorts or re-ghosts
+// atoms) and no break since it was built.
+bool FixBondBreakable::list_current() const {
+  if (!list_valid_) return false;
+  if (domain->xperiodic || domain->yperiodic || domain->zperiodic) return false;  // images move
+  return neighbor->ncalls == list_ncalls_ && atom->nlocal == list_nlocal_ &&
+         atom->nghost == list_nghost_;
+}
+
+// Resolves every bond this rank computes to atom indices and history slots,
+// in the order the per-atom slots are visited (owned atom ascending, slot
+// descending), so that forces are summed in a fixed order.
+void FixBondBreakable::build_bond_list() {
   int *tag = atom->tag;
+  const double *radius = atom->radius;
   const int nlocal = atom->nlocal;
-  const AtomArrays at{atom->x, atom->v, atom->omega, atom->radius, atom->rmass, update->dt};
   const bool periodic = domain->xperiodic || domain->yperiodic || domain->zperiodic;
-
-  if (atom->nmax > nmax_) grow_arrays(atom->nmax);
-  events_.clear();
-  double local[4] = {0.0, 0.0, 0.0, 0.0};  // intact, new tension, new shear, energy
-  BondResult r;
-
+  list_.clear();
   for (int i = 0; i < nlocal; ++i) {
     for (int k = nbond_[i] - 1; k >= 0; --k) {
       double *slot = &bonds_[i][k * NCOL];
@@ -621,66 +621,126 @@ void FixBondBreakable::compute_bonds(bool advance) {
       if (jloc >= 0 && tag[jloc] != ptag) jloc = -1;  // stale map entry
       const bool partner_local = jloc >= 0 && jloc < nlocal;
       const bool i_lower = tag[i] < ptag;
-      if (partner_local && !i_lower) continue;  // the partner's owner (this rank) handles it
+      if (partner_local && !i_lower) continue;  // listed under the partner (lower tag)
       const int jimg = (jloc < 0 || periodic) ? partner_index(i, ptag) : jloc;
 
-      const int a = i_lower ? i : jimg;
-      const int b = i_lower ? jimg : i;
-      evaluate_bond(at, a, b, slot, advance, r);
-
-      int jslot = -1;
+      double *mirror = nullptr;
       if (partner_local) {
-        jslot = find_slot(jloc, tag[i]);
+        const int jslot = find_slot(jloc, tag[i]);
         if (jslot < 0) {
           std::string m = "fix bond/breakable: internal error, bond " + std::to_string(tag[i]) +
                           "-" + std::to_string(ptag) + " stored on one end only";
           fail_one(m);
         }
+        mirror = &bonds_[jloc][jslot * NCOL];
       }
-
-      if (advance && r.mode != 0) {
-        if (i_lower) {  // counted once: by the owner of the lower tag
-          local[r.mode] += 1.0;
-          const double ev[kEventCols] = {static_cast<double>(update->ntimestep),
-                                         update->get_cur_time(),
-                                         r.centre[0],
-                                         r.centre[1],
-                                         r.centre[2],
-                                         static_cast<double>(r.mode),
-                                         static_cast<double>(tag[i]),
-                                         static_cast<double>(ptag),
-                                         r.sigma,
-                                         r.tau};
-          events_.insert(events_.end(), ev, ev + kEventCols);
-        }
-        if (partner_local) remove_slot(jloc, jslot);
-        remove_slot(i, k);
-        continue;
-      }
-
-      // Apply this rank's share: both ends if the partner is owned here.
-      const double *fi = i_lower ? r.fa : nullptr;
-      double fneg[3] = {-r.fa[0], -r.fa[1], -r.fa[2]};
-      if (!i_lower) fi = fneg;
-      const double *ti = i_lower ? r.ta : r.tb;
-      for (int c = 0; c < 3; ++c) {
-        f[i][c] += fi[c];
-        torque[i][c] += ti[c];
-      }
-      if (partner_local) {
-        // i is the lower tag here: the partner is b.
-        for (int c = 0; c < 3; ++c) {
-          f[jloc][c] -= r.fa[c];
-          torque[jloc][c] += r.tb[c];
-        }
-        std::memcpy(&bonds_[jloc][jslot * NCOL + L0], &slot[L0], (NCOL - 1) * sizeof(double));
-      }
-      if (i_lower) {
-        local[0] += 1.0;
-        local[3] += r.energy;
-      }
+      ListedBond lb;
+      lb.a = i_lower ? i : jimg;
+      lb.b = i_lower ? jimg : i;
+      lb.i = i;
+      lb.j = partner_local ? jloc : -1;
+      lb.hist = slot;
+      lb.mirror = mirror;
+      lb.i_lower = i_lower;
+      // Potyondy & Cundall 2004, eq. 5: parallel-bond disc of radius lambda min(Ri,Rj),
+      // A = pi R^2, I = pi R^4 / 4, J = 2 I.
+      lb.rbond = radius_multiplier_ * std::min(radius[lb.a], radius[lb.b]);
+      lb.area = kPi * lb.rbond * lb.rbond;
+      lb.inertia = 0.25 * lb.area * lb.rbond * lb.rbond;
+      lb.polar = 2.0 * lb.inertia;
+      lb.inv_area = 1.0 / lb.area;
+      lb.inv_inertia = 4.0 * kPi * lb.inv_area * lb.inv_area;  // = 1 / (pi R^4 / 4)
+      // Stiffness per unit area from the bond modulus over the initial length,
+      // kn = E_b / L0, ks = kn / (kn/ks)  (Potyondy & Cundall 2004, sec. 2.2).
+      lb.kn = modulus_ / slot[L0];  // [Pa/m]
+      lb.ks = lb.kn * inv_ratio_;   // [Pa/m]
+      list_.push_back(lb);
     }
   }
+  list_valid_ = true;
+  list_ncalls_ = neighbor->ncalls;
+  list_nlocal_ = nlocal;
+  list_nghost_ = atom->nghost;
+}
+
+// Loops over the bonds of owned atoms: advances (if advance), breaks, applies
+// forces, then does this step's single reduction of the global counters.
+void FixBondBreakable::compute_bonds(bool advance) {
+  double **f = atom->f, **torque = atom->torque;
+  int *tag = atom->tag;
+  const int nlocal = atom->nlocal;
+  const AtomArrays at{atom->x, atom->v, atom->omega, atom->radius, atom->rmass, update->dt};
+
+  if (atom->nmax > nmax_) grow_arrays(atom->nmax);
+  if (!list_current()) build_bond_list();
+  events_.clear();
+  broken_.clear();
+  double local[4] = {0.0, 0.0, 0.0, 0.0};  // intact, new tension, new shear, energy
+  BondResult r;
+
+  const int nlisted = static_cast<int>(list_.size());
+  for (int e = 0; e < nlisted; ++e) {
+    const ListedBond &lb = list_[e];
+    evaluate_bond(at, lb, advance, r);
+    const int i = lb.i;
+
+    if (advance && r.mode != 0) {
+      if (lb.i_lower) {  // counted once: by the owner of the lower tag
+        local[r.mode] += 1.0;
+        const double ev[kEventCols] = {static_cast<double>(update->ntimestep),
+                                       update->get_cur_time(),
+                                       r.centre[0],
+                                       r.centre[1],
+                                       r.centre[2],
+                                       static_cast<double>(r.mode),
+                                       static_cast<double>(tag[i]),
+                                       lb.hist[PARTNER],
+                                       r.sigma,
+                                       r.tau};
+        events_.insert(events_.end(), ev, ev + kEventCols);
+      }
+      // Removed after the loop (list entries point at slots), by tag.
+      const int brk[4] = {i, lb.j, tag[i], static_cast<int>(lb.hist[PARTNER])};
+      broken_.insert(broken_.end(), brk, brk + 4);
+      continue;
+    }
+
+    // Apply this rank's share: both ends if the partner is owned here.
+    if (lb.i_lower) {
+      for (int c = 0; c < 3; ++c) {
+        f[i][c] += r.fa[c];
+        torque[i][c] += r.ta[c];
+      }
+    } else {
+      for (int c = 0; c < 3; ++c) {
+        f[i][c] += -r.fa[c];
+        torque[i][c] += r.tb[c];
+      }
+    }
+    if (lb.j >= 0) {
+      // i is the lower tag here: the partner is b.
+      const int j = lb.j;
+      for (int c = 0; c < 3; ++c) {
+        f[j][c] -= r.fa[c];
+        torque[j][c] += r.tb[c];
+      }
+      std::memcpy(&lb.mirror[L0], &lb.hist[L0], (NCOL - 1) * sizeof(double));
+    }
+    if (lb.i_lower) {
+      local[0] += 1.0;
+      local[3] += r.energy;
+    }
+  }
+
+  // Remove the broken bonds from both ends, in list order (slots are found
+  // by tag: a removal moves another slot of the same atom).
+  for (size_t e = 0; e + 4 <= broken_.size(); e += 4) {
+    const int i = broken_[e], j = broken_[e + 1], itag = broken_[e + 2], ptag = broken_[e + 3];
+    if (j >= 0) remove_slot(j, find_slot(j, itag));
+    remove_slot(i, find_slot(i, ptag));
+  }
+  if (!broken_.empty()) list_valid_ = false;
+
   for (int i = 0; i < nlocal; ++i) count_[i] = nbond_[i];
   vector_atom = count_;
 
@@ -902,6 +962,7 @@ void FixBondBreakable::grow_arrays(int nmax) {
   }
   nmax_ = nmax;
   vector_atom = count_;
+  list_valid_ = false;  // the list points into the old storage
 }
 
 // Copies atom i's bonds to slot j (atom sorting, deletion).
@@ -965,7 +1026,8 @@ int FixBondBreakable::size_restart(int nlocal) { return 2 + nbond_[nlocal] * NCO
 // Largest restart size of any atom.
 int FixBondBreakable::maxsize_restart() { return 2 + max_bonds_ * NCOL; }
 
-// Bytes of per-atom storage.
+// Bytes of per-atom storage and of the bond list.
 double FixBondBreakable::memory_usage() {
-  return static_cast<double>(nmax_) * (sizeof(int) + sizeof(double) * (1 + max_bonds_ * NCOL));
+  return static_cast<double>(nmax_) * (sizeof(int) + sizeof(double) * (1 + max_bonds_ * NCOL)) +
+         static_cast<double>(list_.capacity()) * sizeof(ListedBond);
 }

@@ -6,6 +6,10 @@
 // bending moment, twisting moment). The history is mirrored on both atoms and
 // always expressed in the canonical direction lower tag -> higher tag, so that
 // two ranks that each own one end compute bitwise the same bond.
+// Each rank keeps a list of the bonds it computes (atom indices, history
+// slots and the bond's constants), rebuilt only when atoms are exchanged,
+// sorted or re-ghosted and after a break, so that the per-step loop does no
+// tag lookups.
 #ifndef MILL_FIX_BOND_BREAKABLE_H
 #define MILL_FIX_BOND_BREAKABLE_H
 
@@ -92,12 +96,36 @@ class FixBondBreakable : public Fix {
   FILE *break_log_ = nullptr;   // rank 0 only
   std::vector<double> events_;  // break events of this step (local)
 
+  // Bonds this rank computes, in the order of the per-atom slots (owned atom i
+  // ascending, slot descending; a bond with both ends owned here is listed
+  // once, under its lower tag). Valid until atoms are exchanged, sorted or
+  // re-ghosted (a neighbour-list build), a bond breaks, or storage grows.
+  struct ListedBond {
+    int a, b;        // atom indices, a = lower tag (b may be a ghost image)
+    int i;           // owned atom whose slot holds the history
+    int j;           // the partner if it is owned here, else -1
+    double *hist;    // history slot on i
+    double *mirror;  // the partner's copy of the history (j >= 0), else nullptr
+    bool i_lower;    // tag[i] < partner tag
+    // Constants of the bond (radii and L0 do not change during a run):
+    double rbond, area, inertia, polar;  // disc radius [m], A [m^2], I, J [m^4]
+    double inv_area, inv_inertia;        // 1/A, 1/I
+    double kn, ks;                       // stiffness per area [Pa/m]
+  };
+  std::vector<ListedBond> list_;
+  bool list_valid_ = false;
+  bigint list_ncalls_ = -1;  // neighbor->ncalls when the list was built
+  int list_nlocal_ = -1, list_nghost_ = -1;
+  std::vector<int> broken_;  // bonds broken this step: i, j, tag i, partner tag
+
   struct BondResult;
   struct AtomArrays;
+  bool list_current() const;
+  void build_bond_list();
   void parse_args(int narg, char **arg);
   void create_bonds();
   void compute_bonds(bool advance);
-  void evaluate_bond(const AtomArrays &at, int a, int b, double *hist, bool advance,
+  void evaluate_bond(const AtomArrays &at, const ListedBond &bond, bool advance,
                      BondResult &out) const;
   void remove_slot(int i, int slot);
   int find_slot(int i, int partner_tag) const;
