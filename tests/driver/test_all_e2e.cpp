@@ -44,9 +44,14 @@ TEST(WholeWorkflow, StageAllKilledMidBreakageResumesWithoutRedoingJobs) {
 
   // First run: killed once one breakage job is done and the next is running.
   const pid_t pid = spawn_orchestrate(args, dir / "killed.log", dir);
+  bool exited = false;
+  int early_status = 0;
   const bool ready = wait_for([&] {
-    return !breakage_jobs(run, State::Done).empty() && !breakage_jobs(run, State::Running).empty();
+    if (waitpid(pid, &early_status, WNOHANG) == pid) exited = true;  // e.g. an earlier stage failed
+    return exited || (!breakage_jobs(run, State::Done).empty() && !breakage_jobs(run, State::Running).empty());
   }, 600);
+  ASSERT_FALSE(exited) << "orchestrate ended before the kill (status " << early_status << "):\n"
+                       << slurp(dir / "killed.log");
   if (!ready) kill(pid, SIGKILL);
   ASSERT_TRUE(ready) << "never saw a breakage job done and another running:\n" << slurp(dir / "killed.log");
   kill(pid, SIGTERM);
