@@ -84,8 +84,15 @@ TEST(Cli, DryRunListsEveryStageOfBothCases) {
                           "stage report"})
       EXPECT_NE(o.text.find(s), std::string::npos) << c << ": " << s << "\n" << o.text;
     EXPECT_NE(o.text.find("rpm2000"), std::string::npos);
-    EXPECT_NE(o.text.find("v169_a90_r0"), std::string::npos);
   }
+  // default: conditions from transport (two rotor speeds), so breakage waits for it;
+  // reference: an explicit sweep up to 169 m/s.
+  auto def = orchestrate("--case " + kProject + "/cases/default.yaml --stage all --dry-run");
+  EXPECT_NE(def.text.find("rpm1500"), std::string::npos) << def.text;
+  EXPECT_NE(def.text.find("waits for"), std::string::npos) << def.text;
+  EXPECT_NE(def.text.find("transport/rpm2000/impacts.csv"), std::string::npos) << def.text;
+  EXPECT_NE(orchestrate("--case " + kProject + "/cases/reference.yaml --stage all --dry-run").text.find("v169_a90_r0"),
+            std::string::npos);
   auto ref = orchestrate("--case " + kProject + "/cases/reference.yaml --stage breakage --dry-run");
   EXPECT_NE(ref.text.find("39 jobs"), std::string::npos) << ref.text;  // 13 speeds x 3 repeats
 }
