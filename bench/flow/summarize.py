@@ -35,6 +35,11 @@ def main(run: pathlib.Path) -> None:
               f"{rim.get('gas_speed_mean_m_s', 0):.1f}/{rim.get('tip_speed_m_s', 0):.1f} m/s | "
               f"{yp['flywheel']['average']:.0f} ({yp['flywheel']['max']:.0f}) | {yp['housing']['average']:.0f} | "
               f"{r['wall_time_s']['mesh']:.0f} | {r['wall_time_s']['solve']:.0f} |")
+        if r.get("mirrored"):
+            h = r["solved_half"]["mass_flow_kg_s"]
+            print(f"domain: half z >= 0 (symmetry plane z = 0), mirrored: cells are the half's; "
+                  f"mass flows 2 x the half's {h['inlet_in']:.4g} / {h['outlet_out']:.4g} kg/s; "
+                  f"solver CPU rank 0 {r.get('solver_cpu_s_rank0', 0):.1f} s")
         field = run / "sample" / label / "field.h5"
         if not field.exists():
             continue

@@ -215,12 +215,18 @@ std::string case_parameters(const config::Document& doc, double rpm, const MeshP
   const double omega = rpm * 2 * kPi / 60.0;
   const double rr = rotor_zone_radius(g), rt = g.tip_radius();
   const double rim = rt + 0.4 * (rr - rt);
-  const double x0 = -0.5 * g.width, x1 = 0.5 * g.width, z0 = -0.5 * g.depth, z1 = 0.5 * g.depth;
+  // flow.domain = half: only z >= 0 is meshed, with a symmetryPlane patch at z = 0.
+  const bool half = doc.str("flow.domain") == "half";
+  const double x0 = -0.5 * g.width, x1 = 0.5 * g.width, z0 = half ? 0.0 : -0.5 * g.depth,
+               z1 = 0.5 * g.depth;
   const double eps = 0.01 * mp.cell;
   // A gas point between the rotor zone and the roof, off any cell face.
   const double ly = 0.5 * (g.axis_height + rr + g.height) + 0.0371 * mp.cell;
   const double lx = x0 + 0.5 * mp.cell * 1.0731 + 0.0137 * g.width;
-  const double lz = 0.0917 * mp.cell;
+  const double lz = 0.0917 * mp.cell;  // > 0: inside the half domain too
+  // The rim circle lies in the mid-plane; for the half domain just above it
+  // (points exactly on the symmetry plane may be lost by the probe).
+  const double rim_z = half ? 0.02 * mp.cell : 0.0;
   // Initial turbulence: 5% of 30% of the rim speed, length 5% of the tip radius.
   const double u_ref = std::max(1.0, 0.3 * omega * rt);
   const double k0 = 1.5 * std::pow(0.05 * u_ref, 2),
@@ -239,18 +245,24 @@ std::string case_parameters(const config::Document& doc, double rpm, const MeshP
   s += fmt::format("solver          {};  // gas.model = {}\n",
                    comp ? "rhoSimpleFoam" : "simpleFoam", doc.str("gas.model"));
   s += fmt::format("nProcs          {};\nhierarchicalN   (1 {} 1);\n\n", np, np);
+  s += fmt::format(
+      "// flow.domain: half = z >= 0 only, symmetryPlane patch `symmetry` at z = 0\n"
+      "// (blockMeshDict, MRFProperties); full = the whole housing\n"
+      "domain          {};\n\n",
+      half ? "half" : "full");
   s += "// Housing box = background mesh (mill.housing.*), preset " + mp.name + "\n";
   s += fmt::format(
       "xMin {:.10g}; xMax {:.10g};\nyMin 0; yMax {:.10g};\nzMin {:.10g}; zMax {:.10g};\n", x0, x1,
       g.height, z0, z1);
   s += fmt::format("nx {}; ny {}; nz {};\n\n", cells_along(g.width, mp.cell),
-                   cells_along(g.height, mp.cell), cells_along(g.depth, mp.cell));
+                   cells_along(g.height, mp.cell), cells_along(z1 - z0, mp.cell));
   s += "// Flywheel (mill.flywheel.*), rotor zone, rotation (rotor.rpm)\n";
   s += fmt::format("axisX           {:.10g};\naxisY           {:.10g};\ntipRadius       {:.10g};\n",
                    g.axis_x, g.axis_height, rt);
   s += fmt::format("rotorRadius     {:.10g};\nrimRadius       {:.10g};\n", rr, rim);
   s += fmt::format("omega           {:.10g};  // rad/s = {:g} rpm\n", omega, rpm);
-  s += fmt::format("rimStart        {};\n", vec(g.axis_x + rim, g.axis_height, 0));
+  s += fmt::format("rimZ            {:.10g};\nrimStart        {};\n", rim_z,
+                   vec(g.axis_x + rim, g.axis_height, rim_z));
   s += fmt::format("axisPoint1      {};\naxisPoint2      {};\n\n",
                    vec(g.axis_x, g.axis_height, z0 - eps), vec(g.axis_x, g.axis_height, z1 + eps));
   s += "// Openings (mill.inlet.*, mill.outlet.*): boxes picking roof/floor faces\n";
@@ -371,7 +383,7 @@ nlohmann::json read_rim(const fs::path& case_dir, const geometry::MillGeometry& 
   nlohmann::json out;
   if (f.empty()) return out;
   std::ifstream in(f);
-  double x, y, z, ux, uy, uz, sum_mag = 0, sum_tan = 0, r_sum = 0;
+  double x, y, z, ux, uy, uz, sum_mag = 0, sum_tan = 0, r_sum = 0, z_sum = 0;
   int n = 0;
   while (in >> x >> y >> z >> ux >> uy >> uz) {
     const double dx = x - g.axis_x, dy = y - g.axis_height, r = std::hypot(dx, dy);
@@ -379,11 +391,13 @@ nlohmann::json read_rim(const fs::path& case_dir, const geometry::MillGeometry& 
     sum_mag += std::sqrt(ux * ux + uy * uy + uz * uz);
     sum_tan += (-dy * ux + dx * uy) / r;  // positive along the rotation (anticlockwise about +z)
     r_sum += r;
+    z_sum += z;
     ++n;
   }
   if (n == 0) return out;
   const double rim_speed = omega * g.tip_radius();
   out["radius_m"] = r_sum / n;
+  out["z_m"] = z_sum / n;
   out["points"] = n;
   out["tip_speed_m_s"] = rim_speed;
   out["gas_speed_mean_m_s"] = sum_mag / n;
@@ -422,6 +436,10 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
   const double omega = rpm * 2 * flow::kPi / 60.0;
   const long max_it = doc.integer("flow.max_iterations");
   const double target = doc.real("flow.residual_target");
+  // flow.domain = half: the solved case is z >= 0 with a symmetry plane at
+  // z = 0; mass flows and opening areas are doubled to whole-mill values.
+  const bool half = doc.str("flow.domain") == "half";
+  const double mirror = half ? 2.0 : 1.0;
 
   // 1. A fresh case in the job folder.
   const fs::path work = job_dir / "case";
@@ -501,7 +519,7 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
   const double rho = doc.real("gas.density");
   const double to_mass = comp ? 1.0 : rho;  // simpleFoam's phi is m^3/s
   const double in_flux = read_flux(work, "inletFlow"), out_flux = read_flux(work, "outletFlow");
-  const double m_in = -in_flux * to_mass, m_out = out_flux * to_mass;
+  const double m_in = -in_flux * to_mass * mirror, m_out = out_flux * to_mass * mirror;
   const double denom = std::max(std::abs(m_in), std::abs(m_out));
   const double imbalance = denom > 0 ? std::abs(m_in - m_out) / denom : 0.0;
   nlohmann::json rep;
@@ -511,7 +529,14 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
   rep["solver"] = solver;
   rep["mesh_preset"] = preset.name;
   rep["np"] = np;
-  rep["cells"] = cells;
+  rep["cells"] = cells;  // of the solved mesh (the half for flow.domain = half)
+  rep["domain"] = half ? "half" : "full";
+  rep["mirrored"] = half;
+  if (half)
+    rep["mirror_note"] =
+        "solved z >= 0 with a symmetryPlane at z = 0; mass_flow_kg_s and patch_area_m2 are for "
+        "the whole mill (2 x the solved half, see solved_half); cells, rim and y_plus are of the "
+        "solved half";
   rep["iterations"] = s.iterations;
   rep["max_iterations"] = max_it;
   rep["residual_target"] = target;
@@ -519,10 +544,16 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
   rep["final_initial_residuals"] = s.initial_residual;
   rep["mass_flow_kg_s"] = {
       {"inlet_in", m_in}, {"outlet_out", m_out}, {"imbalance_relative", imbalance}};
-  rep["patch_area_m2"] = {{"inlet", read_patch_area(work, "inletFlow")},
-                          {"outlet", read_patch_area(work, "outletFlow")},
+  const double a_in = read_patch_area(work, "inletFlow");
+  const double a_out = read_patch_area(work, "outletFlow");
+  rep["patch_area_m2"] = {{"inlet", a_in * mirror},
+                          {"outlet", a_out * mirror},
                           {"inlet_nominal", geo.inlet_size * geo.inlet_size},
                           {"outlet_nominal", geo.outlet_size * geo.outlet_size}};
+  if (half)
+    rep["solved_half"] = {{"mass_flow_kg_s", {{"inlet_in", -in_flux * to_mass},
+                                              {"outlet_out", out_flux * to_mass}}},
+                          {"patch_area_m2", {{"inlet", a_in}, {"outlet", a_out}}}};
   rep["rim"] = read_rim(work, geo, omega);
   rep["y_plus"] = read_yplus(work);
   rep["solver_cpu_s_rank0"] = s.cpu_seconds;  // ExecutionTime: steadier than wall time on a shared machine
@@ -553,13 +584,14 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
   };
   const auto& rim = rep["rim"];
   ctx.progress.info(
-      fmt::format("{}: {} after {} iterations (p {:.2g}, U {:.2g}; target {:g}); mass flow in "
+      fmt::format("{}: {} after {} iterations (p {:.2g}, U {:.2g}; target {:g}); {}mass flow in "
                   "{:.4g} kg/s, out {:.4g} kg/s, "
                   "imbalance {:.2f}%; gas speed near rim {:.1f} m/s = {:.2f} x tip speed; mean y+ "
                   "flywheel {}, housing {}; "
                   "{} cells; {}",
                   tag, converged ? "converged" : "NOT converged", s.iterations, p_res, u_res,
-                  target, m_in, m_out, 100 * imbalance, rim.value("gas_speed_mean_m_s", 0.0),
+                  target, half ? "half domain mirrored: " : "", m_in, m_out, 100 * imbalance,
+                  rim.value("gas_speed_mean_m_s", 0.0),
                   rim.value("ratio_speed_to_tip_speed", 0.0), ypl("flywheel"), ypl("housing"),
                   cells, Progress::duration(rep["wall_time_s"]["total"].get<double>())));
   if (!converged)

@@ -19,6 +19,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include "geometry/mill_geometry.h"
@@ -38,6 +39,49 @@ constexpr double kAirGasConstant =
 
 template <typename T>
 using Ptr = vtkSmartPointer<T>;
+
+// True for a half-domain case of the flow stage (flow.domain = half): the
+// mesh is z >= 0 with the symmetryPlane patch `symmetry` at z = 0.
+bool half_domain_case(const fs::path& case_dir) {
+  std::ifstream in(case_dir / "constant" / "polyMesh" / "boundary");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  static const std::regex re("\\bsymmetry\\s*\\{[^}]*\\btype\\s+symmetryPlane\\s*;");
+  return std::regex_search(ss.str(), re);
+}
+
+// The probed upper planes of a grid of nz planes symmetric about z = 0
+// (planes nz/2 .. nz-1, z >= 0) reflected onto the whole grid: U_x, U_y,
+// rho, mask (k, omega) even in z, U_z odd.
+post::FlowField mirror_z(const post::FlowField& upper, int nz) {
+  post::FlowField f = upper;
+  const int k0 = nz / 2;
+  if (upper.dims[2] != nz - k0)
+    throw std::invalid_argument(
+        fmt::format("mirror_z: {} probed planes do not make a grid of {}", upper.dims[2], nz));
+  f.dims[2] = nz;
+  f.origin[2] = upper.origin[2] - k0 * upper.spacing[2];
+  f.allocate(!upper.k.empty());
+  const size_t plane = static_cast<size_t>(f.dims[0]) * f.dims[1];
+  for (int k = 0; k < nz; ++k) {
+    const bool reflected = k < k0;
+    const int ks = (reflected ? nz - 1 - k : k) - k0;  // plane of `upper`
+    const size_t dst = k * plane, src = ks * plane;
+    for (size_t q = 0; q < plane; ++q) {
+      f.mask[dst + q] = upper.mask[src + q];
+      f.rho[dst + q] = upper.rho[src + q];
+      for (int c = 0; c < 3; ++c) {
+        const double u = upper.U[3 * (src + q) + c];
+        f.U[3 * (dst + q) + c] = (reflected && c == 2 && u != 0.0) ? -u : u;
+      }
+      if (!upper.k.empty()) {
+        f.k[dst + q] = upper.k[src + q];
+        f.omega[dst + q] = upper.omega[src + q];
+      }
+    }
+  }
+  return f;
+}
 
 // Copy one VTK point array (nc components) into dst, zero where mask = 0.
 void take(vtkDataArray* a, int nc, const std::vector<std::uint8_t>& mask,
@@ -109,7 +153,26 @@ post::FlowField resample_case(const fs::path& case_dir, const GridSpec& grid, co
                        ? times->GetValue(times->GetNumberOfTuples() - 1)
                        : 0.0;
 
-  post::FlowField f = make_grid(grid);
+  const post::FlowField full = make_grid(grid);
+  // Half-domain case (flow.domain = half): the mesh covers z >= 0 only. Probe
+  // the planes k >= k0 of the grid (z >= 0; the grid is symmetric about z = 0
+  // because the box is) and fill the planes k < k0 by reflection below.
+  const bool mirror = half_domain_case(case_dir);
+  int k0 = 0;
+  bool on_plane = false;  // grid plane k0 lies on the symmetry plane z = 0
+  if (mirror) {
+    const double L = grid.hi[2] - grid.lo[2];
+    if (std::abs(grid.lo[2] + grid.hi[2]) > 1e-9 * L)
+      throw std::invalid_argument(fmt::format(
+          "{}: a half-domain case is mirrored about z = 0, but the sampling box z {:g} .. {:g} "
+          "is not symmetric about it",
+          case_dir.string(), grid.lo[2], grid.hi[2]));
+    k0 = full.dims[2] / 2;  // odd nz: the plane z = 0; even nz: the first plane z > 0
+    on_plane = full.dims[2] % 2 == 1;
+  }
+  post::FlowField f = full;  // the probed planes k0 .. nz-1
+  f.dims[2] = full.dims[2] - k0;
+  f.origin[2] = full.origin[2] + k0 * full.spacing[2];
   // Probe on one thread: with VTK's threaded backend each thread keeps its own
   // cell-search hint, so a grid point on a face shared by two cells took the
   // value of either cell depending on thread timing (runs differed by up to
@@ -126,6 +189,13 @@ post::FlowField resample_case(const fs::path& case_dir, const GridSpec& grid, co
     const double e = std::max(1e-6 * f.spacing[d], grid.wall_inset);
     b[2 * d] = f.origin[d] + e;
     b[2 * d + 1] = f.origin[d] + (f.dims[d] - 1) * f.spacing[d] - e;
+  }
+  if (mirror) {
+    // The symmetry plane is a mesh boundary like the walls: probe the grid
+    // plane lying on it just inside the half mesh; other planes as usual.
+    const double e = std::max(1e-6 * f.spacing[2], grid.wall_inset);
+    b[4] = f.origin[2] + (on_plane ? e : 0.0);
+    if (f.dims[2] == 1) b[4] = b[5];
   }
   rs->SetSamplingBounds(b);
   rs->SetSamplingDimensions(f.dims[0], f.dims[1], f.dims[2]);
@@ -159,7 +229,11 @@ post::FlowField resample_case(const fs::path& case_dir, const GridSpec& grid, co
   }
   f.source =
       fmt::format("{} (time {:g}), vtkOpenFOAMReader + vtkResampleToImage", case_dir.string(), t);
-  return f;
+  if (!mirror) return f;
+  if (on_plane)  // the symmetry plane's condition: no flow through it
+    for (int j = 0; j < f.dims[1]; ++j)
+      for (int i = 0; i < f.dims[0]; ++i) f.U[3 * f.point(i, j, 0) + 2] = 0.0;
+  return mirror_z(f, full.dims[2]);
 }
 
 // FlowField -> vtkImageData -> XML (.vti, binary appended, compressed).
@@ -291,6 +365,18 @@ void SampleStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path&
                     doc.where("sample.spacing"), grid.spacing, min_side, 0.5 * min_side));
   sample::Options opt;
   opt.turbulence = doc.boolean("sample.turbulence");
+  // Which part of the housing the flow stage solved: its report and its mesh
+  // (resample_case mirrors a mesh with the `symmetry` plane) must agree.
+  std::ifstream rep_in(flow_out / "flow_report.json");
+  const auto flow_rep = nlohmann::json::parse(rep_in, nullptr, false);
+  const std::string domain =
+      flow_rep.is_object() ? flow_rep.value("domain", std::string("full")) : "full";
+  const bool mirrored = sample::half_domain_case(flow_out / "case");
+  if (mirrored != (domain == "half"))
+    throw std::runtime_error(fmt::format(
+        "{}: flow_report.json says domain '{}' but the mesh {} the symmetry plane of a half "
+        "domain; rerun --stage flow",
+        flow_out.string(), domain, mirrored ? "has" : "lacks"));
   const bool comp = doc.str("gas.model") == "compressible";
   if (!comp) opt.constant_rho = doc.real("gas.density");
 
@@ -298,7 +384,8 @@ void SampleStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path&
   post::FlowField f = sample::resample_case(flow_out / "case", grid, opt);
   f.rpm = job.inputs.at("rotor.rpm").get<double>();
   f.gas_model = doc.str("gas.model");
-  f.source = "flow/" + job.label + "/case, vtkOpenFOAMReader + vtkResampleToImage";
+  f.source = "flow/" + job.label + "/case, vtkOpenFOAMReader + vtkResampleToImage" +
+             (mirrored ? ", half domain z >= 0 mirrored about z = 0 (Uz flipped)" : "");
 
   size_t gas = 0;
   double umax = 0;
@@ -325,6 +412,8 @@ void SampleStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path&
                         {"gas_points", gas},
                         {"gas_fraction", static_cast<double>(gas) / f.size()},
                         {"max_speed_m_s", umax},
+                        {"flow_domain", domain},
+                        {"mirrored_about_z0", mirrored},
                         {"midplane_png",
                          {{"file", "midplane_speed.png"},
                           {"z_m", 0.0},

@@ -1,7 +1,9 @@
 // End to end on the tiny mesh: the flow stage meshes and runs a few dozen
-// iterations of simpleFoam (1 rank) and rhoSimpleFoam (2 ranks, hierarchical),
-// then the sample stage writes field.h5/.vti/.png with the right shape, mask
-// and units. Also the user errors of the sample stage.
+// iterations of simpleFoam (1 rank) and rhoSimpleFoam (2 ranks, hierarchical)
+// on the half domain z >= 0 (flow.domain = half, the default), and simpleFoam
+// on the full housing (2 ranks); then the sample stage writes
+// field.h5/.vti/.png with the right shape, mask and units, mirrored about
+// z = 0 for the half. Also the user errors of the sample stage.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -52,6 +54,74 @@ struct StageRun {
 nlohmann::json read_json(const fs::path& f) {
   std::ifstream in(f);
   return nlohmann::json::parse(in);
+}
+
+// Last "sum(phi)" of a surfaceFieldValue function object of the solved case.
+double raw_flux(const fs::path& case_dir, const std::string& fo) {
+  std::ifstream in(case_dir / "postProcessing" / fo / "0" / "surfaceFieldValue.dat");
+  std::string l, last;
+  while (std::getline(in, l))
+    if (!l.empty() && l[0] != '#') last = l;
+  std::istringstream ss(last);
+  double t = NAN, v = NAN;
+  ss >> t >> v;
+  return v;
+}
+
+// A half-domain run: the report is whole-mill (2 x the solved half) and says
+// so; the sampled field covers the whole housing, mirror-symmetric about z = 0.
+void check_half_domain(const fs::path& run, double to_mass) {
+  const fs::path flow = run / "flow" / "rpm2000";
+  const auto rep = read_json(flow / "flow_report.json");
+  EXPECT_EQ(rep["domain"], "half");
+  EXPECT_EQ(rep["mirrored"], true);
+  const double in_half = -raw_flux(flow / "case", "inletFlow") * to_mass;
+  const double out_half = raw_flux(flow / "case", "outletFlow") * to_mass;
+  ASSERT_TRUE(std::isfinite(in_half) && std::isfinite(out_half));
+  EXPECT_NE(in_half, 0.0);
+  EXPECT_NEAR(rep["mass_flow_kg_s"]["inlet_in"].get<double>(), 2 * in_half,
+              1e-9 * std::abs(in_half));
+  EXPECT_NEAR(rep["mass_flow_kg_s"]["outlet_out"].get<double>(), 2 * out_half,
+              1e-9 * std::abs(out_half));
+  EXPECT_DOUBLE_EQ(rep["solved_half"]["mass_flow_kg_s"]["inlet_in"].get<double>(), in_half);
+  EXPECT_DOUBLE_EQ(rep["patch_area_m2"]["inlet"].get<double>(),
+                   2 * rep["solved_half"]["patch_area_m2"]["inlet"].get<double>());
+  // Whole-mill opening areas: the staircase squares are close to nominal.
+  EXPECT_NEAR(rep["patch_area_m2"]["outlet"].get<double>(),
+              rep["patch_area_m2"]["outlet_nominal"].get<double>(),
+              0.5 * rep["patch_area_m2"]["outlet_nominal"].get<double>());
+  EXPECT_GT(rep["rim"]["z_m"].get<double>(), 0.0) << "rim circle inside the half";
+  // The mesh is the half: z >= 0, symmetry plane at z = 0.
+  std::ifstream b(flow / "case" / "constant" / "polyMesh" / "boundary");
+  std::stringstream bs;
+  bs << b.rdbuf();
+  EXPECT_NE(bs.str().find("symmetryPlane"), std::string::npos);
+
+  const fs::path s = run / "sample" / "rpm2000";
+  const auto srep = read_json(s / "sample_report.json");
+  EXPECT_EQ(srep["mirrored_about_z0"], true);
+  const auto f = post::read_flow_field(s / "field.h5");
+  const int nz = f.dims[2];
+  size_t gas_lower = 0, gas_upper = 0;
+  double uz_max = 0;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < f.dims[1]; ++j)
+      for (int i = 0; i < f.dims[0]; ++i) {
+        const size_t p = f.point(i, j, k), m = f.point(i, j, nz - 1 - k);
+        ASSERT_EQ(f.mask[p], f.mask[m]) << i << " " << j << " " << k;
+        ASSERT_EQ(f.U[3 * p], f.U[3 * m]) << "U_x even in z";
+        ASSERT_EQ(f.U[3 * p + 1], f.U[3 * m + 1]) << "U_y even in z";
+        ASSERT_EQ(f.U[3 * p + 2], -f.U[3 * m + 2]) << "U_z odd in z";
+        ASSERT_EQ(f.rho[p], f.rho[m]);
+        if (!f.k.empty()) {
+          ASSERT_EQ(f.k[p], f.k[m]);
+        }
+        (2 * k < nz - 1 ? gas_lower : gas_upper) += f.mask[p];
+        uz_max = std::max(uz_max, std::abs(f.U[3 * p + 2]));
+      }
+  EXPECT_GT(gas_lower, 0u);
+  EXPECT_EQ(gas_lower, gas_upper);
+  EXPECT_GT(uz_max, 0.0) << "the flow is 3D: the mirror must flip a non-zero U_z";
 }
 
 // Checks shared by both solvers on the default mill sampled at 0.1 m.
@@ -115,6 +185,7 @@ TEST(FlowTiny, IncompressibleMeshRunSample) {
   r.run(flow);
   r.run(sample);
   check_outputs(r.opts.output, true, 1.2, 1.2);
+  check_half_domain(r.opts.output, 1.2);
   EXPECT_NE(r.out.str().find("mass flow"), std::string::npos) << r.out.str();
   // Sampling is repeatable: the same case resampled gives bit-identical fields
   // (a threaded probe picked cells on shared faces by thread timing, up to
@@ -139,6 +210,34 @@ TEST(FlowTiny, CompressibleOnTwoRanksMeshRunSample) {
   EXPECT_TRUE(fs::exists(r.opts.output / "flow" / "rpm2000" / "case" / "processor1"));
   r.run(sample);
   check_outputs(r.opts.output, false, 1.0, 1.4);
+  check_half_domain(r.opts.output, 1.0);  // rhoSimpleFoam's phi is kg/s
+  fs::remove_all(r.opts.output);
+}
+
+// flow.domain = full: today's whole-housing case (no symmetry plane, nothing
+// doubled, nothing mirrored), simpleFoam on 2 ranks.
+TEST(FlowTiny, FullDomainOnTwoRanksMeshRunSample) {
+  StageRun r(kData / "tiny_full.yaml", 2);
+  FlowStage flow;
+  SampleStage sample;
+  r.run(flow);
+  const fs::path out = r.opts.output / "flow" / "rpm2000";
+  const auto rep = read_json(out / "flow_report.json");
+  EXPECT_EQ(rep["domain"], "full");
+  EXPECT_EQ(rep["mirrored"], false);
+  EXPECT_FALSE(rep.contains("solved_half"));
+  EXPECT_DOUBLE_EQ(rep["mass_flow_kg_s"]["inlet_in"].get<double>(),
+                   -raw_flux(out / "case", "inletFlow") * 1.2);
+  std::ifstream b(out / "case" / "constant" / "polyMesh" / "boundary");
+  std::stringstream bs;
+  bs << b.rdbuf();
+  EXPECT_EQ(bs.str().find("symmetry"), std::string::npos) << "no symmetry plane in the full case";
+  EXPECT_EQ(rep["rim"]["z_m"].get<double>(), 0.0);
+  r.run(sample);
+  check_outputs(r.opts.output, false, 1.2, 1.2);
+  EXPECT_EQ(read_json(r.opts.output / "sample" / "rpm2000" / "sample_report.json")
+                ["mirrored_about_z0"],
+            false);
   fs::remove_all(r.opts.output);
 }
 

@@ -29,7 +29,9 @@ std::string header(const std::string& cls, const std::string& obj) {
 
 // A one-block box case with U written at time 1 from the cell centres
 // (blockMesh numbers the cells of one block x fastest, then y, then z).
-fs::path make_case() {
+// half: the face z = 0 is the symmetryPlane patch `symmetry`, as in the flow
+// stage's half-domain case (flow.domain = half).
+fs::path make_case(bool half = false) {
   const fs::path d = fs::temp_directory_path() / ("mill_sampler_" + std::to_string(getpid()));
   fs::remove_all(d);
   fs::create_directories(d / "system");
@@ -44,8 +46,10 @@ fs::path make_case() {
       << "(-0.5 -0.5 0) (0.5 -0.5 0) (0.5 0.5 0) (-0.5 0.5 0)\n"
       << "(-0.5 -0.5 0.2) (0.5 -0.5 0.2) (0.5 0.5 0.2) (-0.5 0.5 0.2)\n);\n"
       << "blocks ( hex (0 1 2 3 4 5 6 7) (20 20 4) simpleGrading (1 1 1) );\n"
-      << "boundary ( walls { type wall; faces ( (0 3 2 1) (4 5 6 7) (0 4 7 3) (1 2 6 5) (0 1 5 4) "
-         "(3 7 6 2) ); } );\n";
+      << (half ? "boundary ( walls { type wall; faces ( (4 5 6 7) (0 4 7 3) (1 2 6 5) (0 1 5 4) "
+                 "(3 7 6 2) ); }\n  symmetry { type symmetryPlane; faces ( (0 3 2 1) ); } );\n"
+               : "boundary ( walls { type wall; faces ( (0 3 2 1) (4 5 6 7) (0 4 7 3) (1 2 6 5) "
+                 "(0 1 5 4) (3 7 6 2) ); } );\n");
   std::ofstream u(d / "1" / "U");
   u << header("volVectorField", "U") << "dimensions [0 1 -1 0 0 0 0];\n"
     << "internalField nonuniform List<vector>\n"
@@ -57,7 +61,7 @@ fs::path make_case() {
         const double y = kLo[1] + (j + 0.5) * (kHi[1] - kLo[1]) / kN[1];
         u << "(" << -kOmega * y << " " << kOmega * x << " 0)\n";
       }
-  u << ");\nboundaryField { walls { type zeroGradient; } }\n";
+  u << ");\nboundaryField { walls { type zeroGradient; } symmetry { type symmetryPlane; } }\n";
   u.close();
   engine::Runner r;
   engine::Command c;
@@ -122,5 +126,56 @@ TEST(Sampler, SolidBodyRotationMatchesAnalyticAndOutsideIsMasked) {
       << "interior: interpolation of a linear field is exact";
   EXPECT_LT(worst_edge, kOmega * h)
       << "near the walls: within the interpolation error at the cell size";
+  fs::remove_all(d);
+}
+
+// A half-domain case (flow.domain = half) is the part z >= 0 of the mill,
+// recognised by its symmetryPlane patch `symmetry`; the sampler probes it and
+// reflects it about z = 0. The box mesh above is such a half (z in [0, 0.2]);
+// solid-body rotation about z is mirror-symmetric, so the whole grid z in
+// [-0.2, 0.2] must match the analytic field, the plane z = 0 must be gas, and
+// the field must be even in z (U_z odd, here 0).
+TEST(Sampler, HalfDomainIsMirroredAboutTheMidPlane) {
+  const fs::path d = make_case(true);
+  sample::Options opt;
+  opt.constant_rho = 1.2;
+  for (double spacing : {0.04, 0.07}) {  // 11 planes (one at z = 0), 6 planes (none)
+    sample::GridSpec g;
+    g.lo = {-0.5, -0.5, -0.2};
+    g.hi = {0.5, 0.5, 0.2};
+    g.spacing = spacing;
+    // wall_inset 0: the plane z = 0 is probed only 1e-6 x spacing inside the
+    // half mesh (the least inset the sampler uses), and x, y are not squeezed.
+    const auto f = sample::resample_case(d, g, opt);
+    const int nz = f.dims[2];
+    ASSERT_EQ(nz, spacing == 0.04 ? 11 : 6);
+    EXPECT_NEAR(f.origin[2], -0.5 * (nz - 1) * spacing, 1e-12);
+    double worst = 0;
+    int gas = 0;
+    for (int k = 0; k < nz; ++k)
+      for (int j = 0; j < f.dims[1]; ++j)
+        for (int i = 0; i < f.dims[0]; ++i) {
+          const size_t p = f.point(i, j, k), m = f.point(i, j, nz - 1 - k);
+          const double x = f.origin[0] + i * f.spacing[0], y = f.origin[1] + j * f.spacing[1];
+          EXPECT_EQ(f.mask[p], 1) << "the whole box is gas, z = " << f.origin[2] + k * spacing;
+          gas += f.mask[p];
+          EXPECT_EQ(f.mask[p], f.mask[m]);
+          EXPECT_EQ(f.U[3 * p], f.U[3 * m]);
+          EXPECT_EQ(f.U[3 * p + 1], f.U[3 * m + 1]);
+          EXPECT_EQ(f.U[3 * p + 2], -f.U[3 * m + 2]);
+          EXPECT_EQ(f.rho[p], f.rho[m]);
+          if (std::abs(x) < 0.5 - 0.05 && std::abs(y) < 0.5 - 0.05)
+            worst = std::max(worst, std::hypot(f.U[3 * p] + kOmega * y,
+                                               f.U[3 * p + 1] - kOmega * x, f.U[3 * p + 2]));
+        }
+    EXPECT_EQ(gas, static_cast<int>(f.size()));
+    EXPECT_LT(worst, 1e-6 * kOmega * 0.5) << "spacing " << spacing;
+  }
+  // The mirror needs a box symmetric about z = 0.
+  sample::GridSpec bad;
+  bad.lo = {-0.5, -0.5, -0.1};
+  bad.hi = {0.5, 0.5, 0.2};
+  bad.spacing = 0.05;
+  EXPECT_THROW(sample::resample_case(d, bad, opt), std::invalid_argument);
   fs::remove_all(d);
 }
