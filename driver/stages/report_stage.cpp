@@ -126,7 +126,8 @@ nlohmann::json headline(const fs::path& run) {
       if (d.filename() == "flow") {
         const auto f = read_json(e.path() / "flow_report.json");
         if (f.is_null()) continue;
-        h["flow"][rpm] = {{"cells", pick(f, "cells")},
+        h["flow"][rpm] = {{"domain", pick(f, "domain")},
+                          {"cells", pick(f, "cells")},
                           {"iterations", pick(f, "iterations")},
                           {"converged", pick(f, "converged")},
                           {"mass_imbalance_relative", pick(pick(f, "mass_flow_kg_s"), "imbalance_relative")},
