@@ -6,7 +6,6 @@
 #include <mpi.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -19,6 +18,7 @@
 #include "error.h"
 #include "memory.h"
 #include "neighbor.h"
+#include "style_args.h"
 #include "update.h"
 
 using namespace LAMMPS_NS;
@@ -66,19 +66,6 @@ inline double norm3(const double *a) { return std::sqrt(dot3(a, a)); }
     const double s = std::sqrt(mag0_sq / mag1_sq);
     for (int k = 0; k < 3; ++k) v[k] *= s;
   }
-}
-
-// Parses a number given for keyword key, or fails with a message naming both.
-double parse_number(Error *error, const char *key, const char *text) {
-  char *end = nullptr;
-  errno = 0;
-  const double v = std::strtod(text, &end);
-  if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
-    std::string msg =
-        std::string("fix bond/breakable: ") + key + " expects a number, got '" + text + "'";
-    error->all(FLERR, msg.c_str());
-  }
-  return v;
 }
 
 // Formats a double the way users wrote it (shortest round-trip-ish form).
@@ -154,54 +141,44 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
     std::string m = "fix bond/breakable: " + msg;
     error->all(FLERR, m.c_str());
   };
+  const mill::StyleArgs args(error, "bond/breakable");
   int iarg = 3;
   while (iarg < narg) {
     const std::string key = arg[iarg];
     if (iarg + 1 >= narg) fail("keyword '" + key + "' needs a value");
     const char *val = arg[iarg + 1];
     if (key == "radius_multiplier") {
-      radius_multiplier_ = parse_number(error, arg[iarg], val);
-      if (!(radius_multiplier_ > 0.0))
-        fail("radius_multiplier must be > 0, got " + std::string(val));
+      radius_multiplier_ = args.positive(arg[iarg], val);
     } else if (key == "modulus") {
-      modulus_ = parse_number(error, arg[iarg], val);
+      modulus_ = args.positive(arg[iarg], val, "Pa");
       have_modulus = true;
-      if (!(modulus_ > 0.0)) fail("modulus must be > 0 Pa, got " + std::string(val));
     } else if (key == "stiffness_ratio") {
-      stiffness_ratio_ = parse_number(error, arg[iarg], val);
+      stiffness_ratio_ = args.positive(arg[iarg], val);
       have_ratio = true;
-      if (!(stiffness_ratio_ > 0.0)) fail("stiffness_ratio must be > 0, got " + std::string(val));
     } else if (key == "tensile_strength") {
-      tensile_strength_ = parse_number(error, arg[iarg], val);
+      tensile_strength_ = args.positive(arg[iarg], val, "Pa");
       have_tensile = true;
-      if (!(tensile_strength_ > 0.0))
-        fail("tensile_strength must be > 0 Pa, got " + std::string(val));
     } else if (key == "cohesion") {
-      cohesion_ = parse_number(error, arg[iarg], val);
+      cohesion_ = args.positive(arg[iarg], val, "Pa");
       have_cohesion = true;
-      if (!(cohesion_ > 0.0)) fail("cohesion must be > 0 Pa, got " + std::string(val));
     } else if (key == "friction_angle") {
-      friction_angle_ = parse_number(error, arg[iarg], val);
+      friction_angle_ = args.real(arg[iarg], val);
       if (!(friction_angle_ >= 0.0 && friction_angle_ < 90.0))
         fail("friction_angle must be in [0, 90) degrees, got " + std::string(val));
     } else if (key == "damping") {
-      damping_ = parse_number(error, arg[iarg], val);
+      damping_ = args.real(arg[iarg], val);
       if (!(damping_ >= 0.0)) fail("damping must be >= 0, got " + std::string(val));
     } else if (key == "gap") {
-      gap_ = parse_number(error, arg[iarg], val);
+      gap_ = args.real(arg[iarg], val);
       if (!(gap_ >= 0.0)) fail("gap must be >= 0, got " + std::string(val));
     } else if (key == "max_bonds") {
-      const double v = parse_number(error, arg[iarg], val);
-      if (!(v >= 1.0 && v <= kMaxBondsLimit && v == std::floor(v)))
-        fail("max_bonds must be an integer in [1, " + std::to_string(kMaxBondsLimit) + "], got " +
-             std::string(val));
-      max_bonds_ = static_cast<int>(v);
+      max_bonds_ = args.integer(arg[iarg], val, 1, kMaxBondsLimit);
     } else if (key == "break_log") {
       break_log_path_ = val;
     } else if (key == "dump_bonds") {
       dump_bonds_path_ = val;
       if (iarg + 3 < narg && std::strcmp(arg[iarg + 2], "every") == 0) {
-        const double v = parse_number(error, "every", arg[iarg + 3]);
+        const double v = args.real("every", arg[iarg + 3]);
         if (!(v >= 1.0 && v == std::floor(v)))
           fail("dump_bonds every must be an integer >= 1 step, got " + std::string(arg[iarg + 3]));
         dump_every_ = static_cast<int>(v);

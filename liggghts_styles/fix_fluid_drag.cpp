@@ -7,7 +7,6 @@
 #include <mpi.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -17,6 +16,7 @@
 #include "comm.h"
 #include "error.h"
 #include "postprocess/flow_field_io.h"
+#include "style_args.h"
 #include "update.h"
 
 using namespace LAMMPS_NS;
@@ -25,19 +25,6 @@ using namespace FixConst;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-// Parses a number given for keyword key, or fails with a message naming both.
-double parse_number(Error *error, const char *key, const char *text) {
-  char *end = nullptr;
-  errno = 0;
-  const double v = std::strtod(text, &end);
-  if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
-    const std::string msg =
-        std::string("fix fluid/drag: ") + key + " expects a number, got '" + text + "'";
-    error->all(FLERR, msg.c_str());
-  }
-  return v;
-}
 
 }  // namespace
 
@@ -82,15 +69,14 @@ void FixFluidDrag::parse_args(int narg, char **arg) {
   auto need = [&](int iarg, int n, const std::string &key) {
     if (iarg + n >= narg) fail("keyword '" + key + "' needs " + std::to_string(n) + " value(s)");
   };
+  const mill::StyleArgs args(error, "fluid/drag");
   bool have_viscosity = false, have_field = false;
   int iarg = 3;
   while (iarg < narg) {
     const std::string key = arg[iarg];
     if (key == "viscosity") {
       need(iarg, 1, key);
-      viscosity_ = parse_number(error, arg[iarg], arg[iarg + 1]);
-      if (!(viscosity_ > 0.0))
-        fail("viscosity must be > 0 Pa s, got " + std::string(arg[iarg + 1]));
+      viscosity_ = args.positive(arg[iarg], arg[iarg + 1], "Pa s");
       have_viscosity = true;
       iarg += 2;
     } else if (key == "field") {
@@ -100,15 +86,15 @@ void FixFluidDrag::parse_args(int narg, char **arg) {
       iarg += 2;
     } else if (key == "uniform") {
       need(iarg, 4, key);
-      for (int d = 0; d < 3; ++d) u_uniform_[d] = parse_number(error, "uniform", arg[iarg + 1 + d]);
-      rho_uniform_ = parse_number(error, "uniform (gas density)", arg[iarg + 4]);
+      for (int d = 0; d < 3; ++d) u_uniform_[d] = args.real("uniform", arg[iarg + 1 + d]);
+      rho_uniform_ = args.real("uniform (gas density)", arg[iarg + 4]);
       if (!(rho_uniform_ > 0.0))
         fail("uniform gas density must be > 0 kg/m^3, got " + std::string(arg[iarg + 4]));
       uniform_ = true;
       iarg += 5;
     } else if (key == "buoyancy") {
       need(iarg, 3, key);
-      for (int d = 0; d < 3; ++d) gravity_[d] = parse_number(error, "buoyancy", arg[iarg + 1 + d]);
+      for (int d = 0; d < 3; ++d) gravity_[d] = args.real("buoyancy", arg[iarg + 1 + d]);
       iarg += 4;
     } else {
       fail("unknown keyword '" + key + "' (expected viscosity, field, uniform, buoyancy)");

@@ -6,7 +6,6 @@
 #include <mpi.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -19,6 +18,7 @@
 #include "fix_mesh.h"
 #include "memory.h"
 #include "modify.h"
+#include "style_args.h"
 #include "update.h"
 
 using namespace LAMMPS_NS;
@@ -93,19 +93,6 @@ void closest_on_triangle(const double *p, const double *a, const double *b, cons
   for (int k = 0; k < 3; ++k) c[k] = a[k] + ab[k] * v + at[k] * w;
 }
 
-// Parses a number given for keyword key, or fails with a message naming both.
-double parse_number(Error *error, const char *key, const char *text) {
-  char *end = nullptr;
-  errno = 0;
-  const double v = std::strtod(text, &end);
-  if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
-    const std::string msg =
-        std::string("fix impact/recorder: ") + key + " expects a number, got '" + text + "'";
-    error->all(FLERR, msg.c_str());
-  }
-  return v;
-}
-
 }  // namespace
 
 /* ---------------------------------------------------------------------- */
@@ -157,6 +144,7 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
   auto need = [&](int iarg, int n, const std::string &key) {
     if (iarg + n >= narg) fail("keyword '" + key + "' needs " + std::to_string(n) + " value(s)");
   };
+  const mill::StyleArgs args(error, "impact/recorder");
   int iarg = 3;
   while (iarg < narg) {
     const std::string key = arg[iarg];
@@ -179,13 +167,13 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
         const std::string sub = arg[iarg];
         if (sub == "omega") {
           need(iarg, 1, sub);
-          s.omega = parse_number(error, "omega", arg[iarg + 1]);
+          s.omega = args.real("omega", arg[iarg + 1]);
           have_omega = true;
           iarg += 2;
         } else if (sub == "origin" || sub == "axis") {
           need(iarg, 3, sub);
           auto &v = sub == "origin" ? s.origin : s.axis;
-          for (int d = 0; d < 3; ++d) v[d] = parse_number(error, sub.c_str(), arg[iarg + 1 + d]);
+          for (int d = 0; d < 3; ++d) v[d] = args.real(sub.c_str(), arg[iarg + 1 + d]);
           (sub == "origin" ? have_origin : have_axis) = true;
           iarg += 4;
         } else {

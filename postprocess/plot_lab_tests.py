@@ -35,68 +35,84 @@ def col(run, key):
     return [r[key] for r in run["rows"]]
 
 
+def plot_test_curves(runs, report, out, test, x, y, mark, xlabel, ylabel, title, filename, decorate=None):
+    """One figure with every run of one lab test (curves.csv `test` column):
+    x and y are (column, convert) pairs; the best iteration's run is drawn thick
+    and a rate-check run (name `rate...`) dashed; mark(ax, run, xs, ys, is_best)
+    adds the test's own peak and fit marks after each curve, decorate(ax) any
+    reference lines after all curves."""
+    best = report["best_iteration"]
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for name, run in runs.items():
+        if run["test"] != test:
+            continue
+        xs = [x[1](v) for v in col(run, x[0])]
+        ys = [y[1](v) for v in col(run, y[0])]
+        is_rate = name.startswith("rate")
+        is_best = run["iteration"] == best and not is_rate
+        label = f"iteration {run['iteration']}, half rate" if is_rate else f"iteration {run['iteration']}"
+        ax.plot(xs, ys, lw=2.0 if is_best else 0.8, ls="--" if is_rate else "-", label=label)
+        mark(ax, run, xs, ys, is_best)
+    if decorate:
+        decorate(ax)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, filename), dpi=120)
+    plt.close(fig)
+
+
 def plot_ucs(runs, report, out):
     """Stress-strain of every UCS run; the best one with its E fit and peak."""
     best = report["best_iteration"]
     it = {i["iteration"]: i for i in report["iterations"]}
-    fig, ax = plt.subplots(figsize=(7, 5))
-    for name, run in runs.items():
-        if run["test"] != "ucs":
-            continue
-        strain = [1e3 * e for e in col(run, "strain")]
-        stress = [s / 1e6 for s in col(run, "stress_Pa")]
-        is_best = run["iteration"] == best and not name.startswith("rate")
-        label = f"iteration {run['iteration']}" if not name.startswith("rate") else f"iteration {run['iteration']}, half rate"
-        ax.plot(strain, stress, lw=2.0 if is_best else 0.8, ls="--" if name.startswith("rate") else "-", label=label)
-        if is_best:
-            k = max(range(len(stress)), key=lambda i: stress[i])
-            ax.plot(strain[k], stress[k], "ko")
-            ax.annotate(f"UCS {stress[k]:.1f} MPa", (strain[k], stress[k]), textcoords="offset points", xytext=(-60, 10))
-            E = it[best]["achieved"]["youngs_modulus"]
-            lo, hi = it[best]["ucs_fit_window_Pa"]
-            # the fitted line over the fit window
-            xs = [e for e, s in zip(strain, stress) if lo / 1e6 <= s <= hi / 1e6][:1]
-            if xs:
-                x0 = xs[0]
-                s0 = stress[strain.index(x0)]
-                x1 = x0 + (hi - lo) / E * 1e3
-                ax.plot([x0, x1], [s0, s0 + (x1 - x0) * E / 1e9], "k:", lw=2,
-                        label=f"E = {E / 1e9:.2f} GPa (fit {lo / 1e6:.1f}-{hi / 1e6:.1f} MPa)")
-    t = report["targets"]
-    ax.axhline(t["ucs"] / 1e6, color="grey", lw=0.8, ls="-.", label=f"target UCS {t['ucs'] / 1e6:.0f} MPa")
-    ax.set_xlabel("axial strain (1e-3)")
-    ax.set_ylabel("axial stress (MPa)")
-    ax.set_title(f"UCS tests, {report['ore']}")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "ucs_stress_strain.png"), dpi=120)
-    plt.close(fig)
+
+    def mark(ax, run, strain, stress, is_best):
+        if not is_best:
+            return
+        k = max(range(len(stress)), key=lambda i: stress[i])
+        ax.plot(strain[k], stress[k], "ko")
+        ax.annotate(f"UCS {stress[k]:.1f} MPa", (strain[k], stress[k]), textcoords="offset points", xytext=(-60, 10))
+        E = it[best]["achieved"]["youngs_modulus"]
+        lo, hi = it[best]["ucs_fit_window_Pa"]
+        # the fitted line over the fit window
+        xs = [e for e, s in zip(strain, stress) if lo / 1e6 <= s <= hi / 1e6][:1]
+        if xs:
+            x0 = xs[0]
+            s0 = stress[strain.index(x0)]
+            x1 = x0 + (hi - lo) / E * 1e3
+            ax.plot([x0, x1], [s0, s0 + (x1 - x0) * E / 1e9], "k:", lw=2,
+                    label=f"E = {E / 1e9:.2f} GPa (fit {lo / 1e6:.1f}-{hi / 1e6:.1f} MPa)")
+
+    def decorate(ax):
+        t = report["targets"]
+        ax.axhline(t["ucs"] / 1e6, color="grey", lw=0.8, ls="-.", label=f"target UCS {t['ucs'] / 1e6:.0f} MPa")
+
+    plot_test_curves(runs, report, out, "ucs",
+                     x=("strain", lambda e: 1e3 * e), y=("stress_Pa", lambda s: s / 1e6), mark=mark,
+                     xlabel="axial strain (1e-3)", ylabel="axial stress (MPa)",
+                     title=f"UCS tests, {report['ore']}", filename="ucs_stress_strain.png", decorate=decorate)
 
 
 def plot_brazilian(runs, report, out):
     """Load-displacement of every Brazilian run, peaks marked."""
-    best = report["best_iteration"]
-    fig, ax = plt.subplots(figsize=(7, 5))
-    for name, run in runs.items():
-        if run["test"] != "brazilian":
-            continue
-        d = [1e6 * x for x in col(run, "displacement_m")]
-        f = [x / 1e3 for x in col(run, "force_N")]
+
+    def mark(ax, run, d, f, is_best):
         st = col(run, "stress_Pa")
-        is_best = run["iteration"] == best
-        ax.plot(d, f, lw=2.0 if is_best else 0.8, label=f"iteration {run['iteration']}")
         k = max(range(len(f)), key=lambda i: f[i])
         ax.plot(d[k], f[k], "ko" if is_best else "k.")
         if is_best:
             ax.annotate(f"peak {f[k]:.2f} kN, sigma_t {st[k] / 1e6:.2f} MPa", (d[k], f[k]),
                         textcoords="offset points", xytext=(-200, 8))
-    ax.set_xlabel("jaw closure (um)")
-    ax.set_ylabel("load (kN)")
-    ax.set_title(f"Brazilian tests, {report['ore']} (target {report['targets']['tensile_strength'] / 1e6:.1f} MPa)")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "brazilian_load_displacement.png"), dpi=120)
-    plt.close(fig)
+
+    plot_test_curves(runs, report, out, "brazilian",
+                     x=("displacement_m", lambda x: 1e6 * x), y=("force_N", lambda x: x / 1e3), mark=mark,
+                     xlabel="jaw closure (um)", ylabel="load (kN)",
+                     title=f"Brazilian tests, {report['ore']} "
+                           f"(target {report['targets']['tensile_strength'] / 1e6:.1f} MPa)",
+                     filename="brazilian_load_displacement.png")
 
 
 def plot_convergence(report, out):
