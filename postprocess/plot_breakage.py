@@ -123,14 +123,14 @@ def save(fig, path):
 
 
 def angle_label(angle):
-    """Legend label of an impact angle."""
-    return f"{angle:g} deg"
+    """Legend label of an impact angle (None: conditions of several angles pooled)."""
+    return "all conditions" if angle is None else f"{angle:g} deg"
 
 
 def plot_pieces(by_angle, path):
     """Single- and multi-element piece counts vs speed, mean and min/max."""
     fig, ax = plt.subplots(figsize=(7, 4.5))
-    for angle, rows in sorted(by_angle.items()):
+    for angle, rows in sorted(by_angle.items(), key=lambda kv: -1 if kv[0] is None else kv[0]):
         for key, style, name in (("n_single", "o-", "single (fully shredded)"),
                                  ("n_multi", "s--", "multi (partially shredded)")):
             v, mean, lo, hi = stats_by_velocity(rows, key)
@@ -147,7 +147,7 @@ def plot_pieces(by_angle, path):
 def plot_largest(by_angle, critical, threshold, path):
     """Largest piece mass fraction vs speed with the threshold and critical speed."""
     fig, ax = plt.subplots(figsize=(7, 4.5))
-    for angle, rows in sorted(by_angle.items()):
+    for angle, rows in sorted(by_angle.items(), key=lambda kv: -1 if kv[0] is None else kv[0]):
         v, mean, lo, hi = stats_by_velocity(rows, "largest_mass_fraction")
         line, = ax.plot(v, mean, "o-", label=f"mean, {angle_label(angle)}")
         ax.fill_between(v, lo, hi, color=line.get_color(), alpha=0.2)
@@ -225,6 +225,9 @@ def main(argv=None):
     p.add_argument("--threshold", type=float, default=0.05,
                    help="largest piece fraction below which the lump counts as shattered")
     p.add_argument("--velocities", default="", help="speeds for the distribution plot, m/s")
+    p.add_argument("--pool-angles", action="store_true",
+                   help="one curve over all rows (conditions binned from transport: each bin has its own "
+                        "speed and angle, so per-angle curves would have one point each)")
     a = p.parse_args(argv)
     if not 0.0 < a.threshold < 1.0:
         sys.exit(f"--threshold: expected a fraction in (0, 1), got {a.threshold}")
@@ -237,7 +240,7 @@ def main(argv=None):
 
     by_angle = defaultdict(list)
     for r in summary:
-        by_angle[r["angle_deg"]].append(r)
+        by_angle[None if a.pool_angles else r["angle_deg"]].append(r)
     critical = {angle: critical_velocity(rows, a.threshold) for angle, rows in by_angle.items()}
 
     plot_pieces(by_angle, os.path.join(a.out, "pieces_vs_velocity.png"))
@@ -247,7 +250,8 @@ def main(argv=None):
 
     out = {"threshold": a.threshold,
            "quantity": "largest_mass_fraction",
-           "angles": {f"{angle:g}": c for angle, c in sorted(critical.items())}}
+           "angles": {("all" if angle is None else f"{angle:g}"): c
+                      for angle, c in sorted(critical.items(), key=lambda kv: -1 if kv[0] is None else kv[0])}}
     path = os.path.join(a.out, "critical_velocity.json")
     with open(path + ".tmp", "w") as f:
         json.dump(out, f, indent=2)

@@ -298,25 +298,34 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& jobs
   post::MergeBreakageH5Files((dir / "breakage.h5").string(), h5);
 
   // Critical velocity per angle: largest piece falls below the threshold.
+  // Conditions binned from transport each have their own speed and angle, so
+  // they are pooled into one curve over impact speed (angle_deg null).
+  const bool pooled = ctx.cfg.doc.str("breakage.conditions") == "transport";
+  constexpr double kPooled = -1.0;
   const double thr = ctx.cfg.doc.real("breakage.critical_largest_fraction");
   nlohmann::json crit = nlohmann::json::array();
   std::map<double, std::vector<post::SweepPoint>> by_angle;
-  for (const auto& s : rows) by_angle[s.angle_deg].push_back({s.velocity_m_s, s.repeat, s.largest_mass_fraction});
+  for (const auto& s : rows)
+    by_angle[pooled ? kPooled : s.angle_deg].push_back({s.velocity_m_s, s.repeat, s.largest_mass_fraction});
   for (const auto& [angle, pts] : by_angle) {
     const auto c = post::FindCriticalVelocity(pts, thr);
-    nlohmann::json e = {{"angle_deg", angle}, {"threshold", thr}, {"repeats_crossing", c.n_crossed}};
+    const std::string where = pooled ? "over all conditions, angles pooled," : fmt::format("at {:g} deg", angle);
+    nlohmann::json e = {{"angle_deg", pooled ? nlohmann::json(nullptr) : nlohmann::json(angle)},
+                        {"threshold", thr},
+                        {"repeats_crossing", c.n_crossed}};
+    if (pooled) e["note"] = "conditions binned from transport: every bin has its own speed and angle; pooled";
     e["critical_velocity_m_s"] = c.of_mean_curve ? nlohmann::json(*c.of_mean_curve) : nlohmann::json(nullptr);
     e["min_m_s"] = c.min ? nlohmann::json(*c.min) : nlohmann::json(nullptr);
     e["max_m_s"] = c.max ? nlohmann::json(*c.max) : nlohmann::json(nullptr);
     crit.push_back(e);
     ctx.progress.info(c.of_mean_curve
-                          ? fmt::format("[breakage] critical velocity at {:g} deg (largest piece < {:g}%): {:.1f} m/s{}",
-                                        angle, 100 * thr, *c.of_mean_curve,
+                          ? fmt::format("[breakage] critical velocity {} (largest piece < {:g}%): {:.1f} m/s{}", where,
+                                        100 * thr, *c.of_mean_curve,
                                         c.min && c.max && *c.min != *c.max
                                             ? fmt::format(" (repeats {:.1f}-{:.1f} m/s)", *c.min, *c.max)
                                             : "")
-                          : fmt::format("[breakage] at {:g} deg the largest piece never fell below {:g}% in the sweep",
-                                        angle, 100 * thr));
+                          : fmt::format("[breakage] {} the largest piece never fell below {:g}% in the sweep", where,
+                                        100 * thr));
   }
   jobs::atomic_write(dir / "critical_velocity.json", crit.dump(2) + "\n");
 
@@ -325,6 +334,7 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& jobs
   c.argv = {"/usr/bin/python3", (ctx.cfg.project_dir / "postprocess" / "plot_breakage.py").string(),
             "--summary", (dir / "summary.csv").string(), "--fractions", (dir / "fractions.csv").string(),
             "--out", (dir / "plots").string(), "--threshold", num(thr)};
+  if (pooled) c.argv.push_back("--pool-angles");
   c.cwd = dir;
   c.log = dir / "plots.log";
   c.job = "breakage/plots";

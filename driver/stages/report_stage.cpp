@@ -151,15 +151,18 @@ nlohmann::json headline(const fs::path& run) {
                         {"achieved", pick(cal, "achieved")}};
   const auto crit = read_json(run / "breakage" / "critical_velocity.json");
   if (crit.is_array()) {
-    for (const auto& c : crit)
-      h["breakage"]["critical_velocity_m_s"][fmt::format("{:g} deg", pick(c, "angle_deg").get<double>())] =
+    for (const auto& c : crit) {
+      const auto angle = pick(c, "angle_deg");
+      h["breakage"]["critical_velocity_m_s"][angle.is_number() ? fmt::format("{:g} deg", angle.get<double>())
+                                                               : std::string("all conditions")] =
           pick(c, "critical_velocity_m_s");
+    }
     h["breakage"]["critical_largest_fraction"] = crit.empty() ? nlohmann::json(nullptr) : pick(crit[0], "threshold");
   }
   const auto prod = read_json(run / "breakage" / "product.json");
   if (prod.is_array())
     for (const auto& p : prod)
-      h["product"][fmt::format("rpm{:g}", pick(p, "rpm").get<double>())] = {
+      if (pick(p, "rpm").is_number()) h["product"][fmt::format("rpm{:g}", pick(p, "rpm").get<double>())] = {
           {"fully_shredded_mass_fraction", pick(p, "fully_shredded_mass_fraction")},
           {"largest_piece_mass_fraction", pick(p, "largest_piece_mass_fraction")},
           {"t10_percent", pick(p, "t10_percent")},

@@ -98,6 +98,11 @@ TEST(WholeWorkflow, StageAllKilledMidBreakageResumesWithoutRedoingJobs) {
   EXPECT_NE(html.find("Stage 1b: ore lumps through the mill"), std::string::npos);
   EXPECT_NE(html.find("sample/rpm2000/"), std::string::npos);
   EXPECT_TRUE(fs::exists(run / "breakage/plots/product_vs_rpm.png"));
+  // Conditions binned from transport have one speed and angle each: the
+  // critical velocity is taken over all of them pooled, not per angle.
+  const auto crit = nlohmann::json::parse(slurp(run / "breakage/critical_velocity.json"));
+  ASSERT_EQ(crit.size(), 1u) << crit.dump();
+  EXPECT_TRUE(crit[0].at("angle_deg").is_null());
   EXPECT_TRUE(fs::exists(run / "report/figures/mill_geometry.png"));
   EXPECT_TRUE(fs::exists(run / "report/figures/flow_convergence_rpm2000.png"));
   EXPECT_NE(html.find("mill geometry (STL)"), std::string::npos);
