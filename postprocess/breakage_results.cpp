@@ -442,6 +442,23 @@ void AppendFractionsCsv(const std::string& path, const ImpactResult& result) {
   AppendCsvRows(path, JoinCsv(FractionsCsvColumns()), rows);
 }
 
+// The number in one CSV cell, or a PostError naming file, line and column.
+static double ParseCsvNumber(const std::string& path, long line_no, const std::string& column,
+                             const std::string& cell) {
+  std::size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(cell, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != cell.size()) {
+    throw PostError(
+        fmt::format("{}:{}: {}: expected a number, got '{}'", path, line_no, column, cell));
+  }
+  return v;
+}
+
 // One fractions.csv line.
 std::string FractionsCsvLine(const FractionRow& r) {
   return fmt::format("{},{},{},{},{},{},{}", r.conditions.velocity_m_s, r.conditions.angle_deg,
@@ -472,18 +489,8 @@ std::vector<FractionRow> ReadFractionsCsv(const std::string& path) {
                                   names.size()));
     }
     double v[7];
-    for (std::size_t c = 0; c < names.size(); ++c) {
-      std::size_t used = 0;
-      try {
-        v[c] = std::stod(cells[c], &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != cells[c].size()) {
-        throw PostError(fmt::format("{}:{}: {}: expected a number, got '{}'", path, line_no,
-                                    names[c], cells[c]));
-      }
-    }
+    for (std::size_t c = 0; c < names.size(); ++c)
+      v[c] = ParseCsvNumber(path, line_no, names[c], cells[c]);
     if (v[3] < 0 || v[3] != static_cast<int>(v[3])) {
       throw PostError(fmt::format("{}:{}: fraction_index: expected a whole number >= 0, got '{}'",
                                   path, line_no, cells[3]));
@@ -527,19 +534,8 @@ std::vector<ImpactSummary> ReadSummaryCsv(const std::string& path) {
     ImpactSummary s;
     for (std::size_t c = 0; c < cols.size(); ++c) {
       if (pos[c] < 0) continue;
-      const std::string& cell = cells[static_cast<std::size_t>(pos[c])];
-      std::size_t used = 0;
-      double v = 0.0;
-      try {
-        v = std::stod(cell, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != cell.size()) {
-        throw PostError(fmt::format("{}:{}: {}: expected a number, got '{}'", path, line_no,
-                                    cols[c].name, cell));
-      }
-      cols[c].set(s, v);
+      cols[c].set(s, ParseCsvNumber(path, line_no, cols[c].name,
+                                    cells[static_cast<std::size_t>(pos[c])]));
     }
     rows.push_back(s);
   }
