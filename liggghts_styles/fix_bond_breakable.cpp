@@ -86,6 +86,7 @@ struct FixBondBreakable::BondResult {
   double tau;        // max shear stress [Pa]
   double strength;   // shear strength at this normal stress [Pa]
   double energy;     // elastic energy stored in the bond [J]
+  double stretch;    // L - L0 [m] (< 0: compressed)
   double centre[3];  // bond centre (contact point)
   int mode;          // 0 intact, 1 tension, 2 shear
 };
@@ -168,6 +169,14 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
     } else if (key == "damping") {
       damping_ = args.real(arg[iarg], val);
       if (!(damping_ >= 0.0)) fail("damping must be >= 0, got " + std::string(val));
+    } else if (key == "moment_factor") {
+      moment_factor_ = args.real(arg[iarg], val);
+      if (!(moment_factor_ >= 0.0 && moment_factor_ <= 1.0))
+        fail("moment_factor must be in [0, 1], got " + std::string(val));
+    } else if (key == "broken_contact") {
+      const std::string v = val;
+      if (v != "yes" && v != "no") fail("broken_contact must be yes or no, got '" + v + "'");
+      broken_contact_ = v == "yes";
     } else if (key == "gap") {
       gap_ = args.real(arg[iarg], val);
       if (!(gap_ >= 0.0)) fail("gap must be >= 0, got " + std::string(val));
@@ -187,7 +196,8 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
     } else {
       fail("unknown keyword '" + key +
            "' (expected radius_multiplier, modulus, stiffness_ratio, tensile_strength, cohesion, "
-           "friction_angle, damping, gap, max_bonds, break_log, dump_bonds)");
+           "friction_angle, moment_factor, broken_contact, damping, gap, max_bonds, break_log, "
+           "dump_bonds)");
     }
     iarg += 2;
   }
@@ -434,6 +444,14 @@ int FixBondBreakable::partner_index(int i, int partner_tag) const {
   return j;
 }
 
+// Intact bonds of atom i (its slots less the broken bonds kept as contacts).
+int FixBondBreakable::intact_bonds(int i) const {
+  if (!broken_contact_) return nbond_[i];
+  int n = 0;
+  for (int k = 0; k < nbond_[i]; ++k) n += bonds_[i][k * NCOL + STATE] == 0.0;
+  return n;
+}
+
 // Slot of the bond to partner_tag in atom i's list, or -1.
 int FixBondBreakable::find_slot(int i, int partner_tag) const {
   const double key = partner_tag;  // tags are stored exactly as doubles
@@ -520,17 +538,21 @@ void FixBondBreakable::evaluate_bond(const AtomArrays &at, const ListedBond &bon
   // (the total form of P&C eq. 6's normal increment).
   const double stretch = len - l0;
   const double fn = kn * area * stretch;
+  out.stretch = stretch;
 
-  // Potyondy & Cundall 2004, eq. 7: extreme stresses on the bond periphery;
-  // compressive normal force never counts as tension.
+  // Potyondy & Cundall 2004, eq. 7, with the moment-contribution factor beta of
+  // the linear parallel bond (Potyondy 2015, sec. 2; Itasca PFC 5 manual,
+  // "Linear Parallel Bond Model"): extreme stresses on the bond periphery. The normal force keeps its sign (tension > 0): a
+  // compressed bond needs more bending to fail in tension.
   const double mb_sq = dot3(mb, mb), fs_sq = dot3(fs, fs);
   const double mb_mag = std::sqrt(mb_sq);
   const double fs_mag = std::sqrt(fs_sq);
-  out.sigma = std::max(fn, 0.0) * inv_area + mb_mag * rbond * inv_inertia;
-  out.tau = fs_mag * inv_area + std::fabs(mt) * rbond * 0.5 * inv_inertia;
-  // Mohr-Coulomb shear strength, compressive normal stress only (Potyondy 2015,
-  // linear parallel bond: tau_c = c - sigma tan(phi) with sigma < 0 compressive).
-  out.strength = cohesion_ + tan_friction_ * std::max(-fn, 0.0) * inv_area;
+  const double sigma_n = fn * inv_area;  // mean normal stress, tension > 0
+  out.sigma = sigma_n + moment_factor_ * mb_mag * rbond * inv_inertia;
+  out.tau = fs_mag * inv_area + moment_factor_ * std::fabs(mt) * rbond * 0.5 * inv_inertia;
+  // Mohr-Coulomb shear strength on the mean normal stress (same sources:
+  // tau_c = c - sigma_n tan(phi), tension > 0): compression raises it.
+  out.strength = cohesion_ - tan_friction_ * sigma_n;
   out.mode = 0;
   if (out.sigma > tensile_strength_)
     out.mode = 1;
@@ -569,6 +591,70 @@ void FixBondBreakable::evaluate_bond(const AtomArrays &at, const ListedBond &bon
     out.ta[k] = tqa[k] - m;
     out.tb[k] = tqb[k] + m;
   }
+}
+
+// A broken bond kept as a contact (broken_contact yes): while the pair is
+// closer than its bonding distance L0 it pushes back with the bond's normal
+// stiffness, F_n = kn A (L - L0) < 0, and resists sliding with an incremental
+// shear force ks A dU_s capped by Coulomb friction, |F_s| <= tan(phi) |F_n|;
+// no moments, no tension (the crushed cement bears load only in compression,
+// as the linear contact beside a broken parallel bond does in Potyondy &
+// Cundall 2004, sec. 2.2). Returns false once L >= L0: the pair has separated
+// past its initial gap and the contact is dropped.
+bool FixBondBreakable::evaluate_contact(const AtomArrays &at, const ListedBond &bond, bool advance,
+                                        BondResult &out) const {
+  const int a = bond.a, b = bond.b;
+  double *hist = bond.hist;
+  const double xa[3] = {at.x[a][0], at.x[a][1], at.x[a][2]};
+  const double d[3] = {at.x[b][0] - xa[0], at.x[b][1] - xa[1], at.x[b][2] - xa[2]};
+  const double len = norm3(d);
+  const double stretch = len - hist[L0];
+  out.mode = 0;
+  out.energy = 0.0;
+  out.stretch = stretch;
+  if (stretch >= 0.0) return false;
+  const double inv_len = 1.0 / len;
+  const double n[3] = {d[0] * inv_len, d[1] * inv_len, d[2] * inv_len};
+  const double wa[3] = {at.omega[a][0], at.omega[a][1], at.omega[a][2]};
+  const double wb[3] = {at.omega[b][0], at.omega[b][1], at.omega[b][2]};
+  const double ra_s = at.radius[a], rb_s = at.radius[b];
+  const double arm_a = len * ra_s / (ra_s + rb_s), arm_b = len - arm_a;
+  const double ra_vec[3] = {arm_a * n[0], arm_a * n[1], arm_a * n[2]};
+  const double rb_vec[3] = {-arm_b * n[0], -arm_b * n[1], -arm_b * n[2]};
+  double wa_r[3], wb_r[3];
+  cross3(wa, ra_vec, wa_r);
+  cross3(wb, rb_vec, wb_r);
+  double vrel[3];
+  for (int k = 0; k < 3; ++k) vrel[k] = at.v[b][k] - at.v[a][k] + wb_r[k] - wa_r[k];
+  const double vn = dot3(vrel, n);
+  const double vt[3] = {vrel[0] - vn * n[0], vrel[1] - vn * n[1], vrel[2] - vn * n[2]};
+
+  const double fn = bond.kn * bond.area * stretch;  // < 0: compression
+  double fs[3] = {hist[FS], hist[FS + 1], hist[FS + 2]};
+  if (advance) {
+    rotate_onto_plane(fs, n, 0.5 * (dot3(wa, n) + dot3(wb, n)) * at.dt);
+    const double ksa_dt = bond.ks * bond.area * at.dt;
+    for (int k = 0; k < 3; ++k) fs[k] -= ksa_dt * vt[k];
+  }
+  const double cap = tan_friction_ * (-fn), fs_mag = norm3(fs);
+  if (fs_mag > cap) {  // Coulomb slip: the stored force stays on the cone
+    const double s = fs_mag > 0.0 ? cap / fs_mag : 0.0;
+    for (int k = 0; k < 3; ++k) fs[k] *= s;
+  }
+  if (advance)
+    for (int k = 0; k < 3; ++k) hist[FS + k] = fs[k];
+
+  double fb[3];
+  for (int k = 0; k < 3; ++k) fb[k] = -fn * n[k] + fs[k];
+  if (damping_ > 0.0) {
+    const double ma = at.rmass[a], mbm = at.rmass[b];
+    const double cn = 2.0 * damping_ * std::sqrt(ma * mbm / (ma + mbm) * bond.kn * bond.area);
+    for (int k = 0; k < 3; ++k) fb[k] -= cn * vn * n[k];
+  }
+  for (int k = 0; k < 3; ++k) out.fa[k] = -fb[k];
+  cross3(ra_vec, out.fa, out.ta);
+  cross3(rb_vec, fb, out.tb);
+  return true;
 }
 
 // True while the cached bond list still matches the atom arrays: no
@@ -652,37 +738,14 @@ void FixBondBreakable::compute_bonds(bool advance) {
   if (!list_current()) build_bond_list();
   events_.clear();
   broken_.clear();
+  contact_.clear();
   double local[4] = {0.0, 0.0, 0.0, 0.0};  // intact, new tension, new shear, energy
   BondResult r;
 
-  const int nlisted = static_cast<int>(list_.size());
-  for (int e = 0; e < nlisted; ++e) {
-    const ListedBond &lb = list_[e];
-    evaluate_bond(at, lb, advance, r);
+  // Adds this rank's share of a bond's (or contact's) force and torques: both
+  // ends if the partner is owned here, then mirrors the history.
+  auto apply = [&](const ListedBond &lb) {
     const int i = lb.i;
-
-    if (advance && r.mode != 0) {
-      if (lb.i_lower) {  // counted once: by the owner of the lower tag
-        local[r.mode] += 1.0;
-        const double ev[kEventCols] = {static_cast<double>(update->ntimestep),
-                                       update->get_cur_time(),
-                                       r.centre[0],
-                                       r.centre[1],
-                                       r.centre[2],
-                                       static_cast<double>(r.mode),
-                                       static_cast<double>(tag[i]),
-                                       lb.hist[PARTNER],
-                                       r.sigma,
-                                       r.tau};
-        events_.insert(events_.end(), ev, ev + kEventCols);
-      }
-      // Removed after the loop (list entries point at slots), by tag.
-      const int brk[4] = {i, lb.j, tag[i], static_cast<int>(lb.hist[PARTNER])};
-      broken_.insert(broken_.end(), brk, brk + 4);
-      continue;
-    }
-
-    // Apply this rank's share: both ends if the partner is owned here.
     if (lb.i_lower) {
       for (int c = 0; c < 3; ++c) {
         f[i][c] += r.fa[c];
@@ -703,10 +766,62 @@ void FixBondBreakable::compute_bonds(bool advance) {
       }
       std::memcpy(&lb.mirror[L0], &lb.hist[L0], (NCOL - 1) * sizeof(double));
     }
+  };
+  // Queues the slots of list entry lb for removal after the loop (by tag).
+  auto remove_later = [&](const ListedBond &lb) {
+    const int brk[4] = {lb.i, lb.j, tag[lb.i], static_cast<int>(lb.hist[PARTNER])};
+    broken_.insert(broken_.end(), brk, brk + 4);
+  };
+
+  const int nlisted = static_cast<int>(list_.size());
+  for (int e = 0; e < nlisted; ++e) {
+    const ListedBond &lb = list_[e];
+    if (lb.hist[STATE] != 0.0) {  // a broken bond kept as a contact
+      if (evaluate_contact(at, lb, advance, r))
+        apply(lb);
+      else if (advance)
+        remove_later(lb);
+      continue;
+    }
+    evaluate_bond(at, lb, advance, r);
+
+    if (advance && r.mode != 0) {
+      if (lb.i_lower) {  // counted once: by the owner of the lower tag
+        local[r.mode] += 1.0;
+        const double ev[kEventCols] = {static_cast<double>(update->ntimestep),
+                                       update->get_cur_time(),
+                                       r.centre[0],
+                                       r.centre[1],
+                                       r.centre[2],
+                                       static_cast<double>(r.mode),
+                                       static_cast<double>(tag[lb.i]),
+                                       lb.hist[PARTNER],
+                                       r.sigma,
+                                       r.tau};
+        events_.insert(events_.end(), ev, ev + kEventCols);
+      }
+      // A bond broken while compressed stays as a contact (broken_contact
+      // yes); otherwise it is removed after the loop (entries point at slots).
+      if (broken_contact_ && r.stretch < 0.0)
+        contact_.push_back(e);
+      else
+        remove_later(lb);
+      continue;
+    }
+
+    apply(lb);
     if (lb.i_lower) {
       local[0] += 1.0;
       local[3] += r.energy;
     }
+  }
+
+  // Bonds broken in compression become contacts: state 1, no stored load.
+  for (const int e : contact_) {
+    const ListedBond &lb = list_[e];
+    for (int k = FS; k < STATE; ++k) lb.hist[k] = 0.0;
+    lb.hist[STATE] = 1.0;
+    if (lb.mirror) std::memcpy(&lb.mirror[L0], &lb.hist[L0], (NCOL - 1) * sizeof(double));
   }
 
   // Remove the broken bonds from both ends, in list order (slots are found
@@ -718,7 +833,7 @@ void FixBondBreakable::compute_bonds(bool advance) {
   }
   if (!broken_.empty()) list_valid_ = false;
 
-  for (int i = 0; i < nlocal; ++i) count_[i] = nbond_[i];
+  for (int i = 0; i < nlocal; ++i) count_[i] = intact_bonds(i);
   vector_atom = count_;
 
   double global[4];
@@ -761,6 +876,7 @@ void FixBondBreakable::write_bond_dump() {
   for (int i = 0; i < atom->nlocal; ++i)
     for (int k = 0; k < nbond_[i]; ++k) {
       const int p = static_cast<int>(bonds_[i][k * NCOL + PARTNER]);
+      if (bonds_[i][k * NCOL + STATE] != 0.0) continue;  // a contact, not a bond
       if (atom->tag[i] < p) {
         mine.push_back(atom->tag[i]);
         mine.push_back(p);
@@ -803,49 +919,55 @@ void FixBondBreakable::write_bond_dump() {
   }
 }
 
-// Critical time step of the bond springs from a Gershgorin bound on the
-// largest eigenfrequency of the mass-weighted stiffness (rows of atom i: the
-// diagonal plus the partner terms, and the translation-rotation coupling
-// ks A r / sqrt(m I) of the shear spring); velocity Verlet is stable for
-// omega dt < 2. Printed; warns if the deck's dt exceeds it.
+// Critical time step of the bond springs. Per bond, the largest squared
+// eigenfrequency of the free bonded pair is exact and in closed form: the
+// 12 x 12 pair problem splits into the axial mode, kn A (1/ma + 1/mb); the
+// twist, ks J (1/Ia + 1/Ib); and, in each of the two transverse planes, a
+// shear-bending block of rank 2 (shear spring ks A on g = (-1, 1, -ra, -rb)
+// over (ua, ub, theta_a, theta_b), bending spring kn I on h = (0, 0, -1, 1))
+// whose non-zero eigenvalues are those of the 2 x 2 Gram matrix
+//   [ ks A g.M^-1.g            sqrt(ks A kn I) g.M^-1.h ]
+//   [ sqrt(ks A kn I) g.M^-1.h   kn I h.M^-1.h          ].
+// An atom's estimate sums its bonds' values (exact for a pair and for the
+// axial mode of a uniform chain); velocity Verlet is stable for omega dt < 2.
+// Printed; warns if the deck's dt exceeds it.
 void FixBondBreakable::estimate_time_step() {
   double *radius = atom->radius, *rmass = atom->rmass;
-  double local[2] = {1e300, 1e300};
+  double local = 0.0;  // largest per-atom sum of the bonds' omega^2
   for (int i = 0; i < atom->nlocal; ++i) {
-    if (nbond_[i] == 0) continue;
-    const double irot = 0.4 * rmass[i] * radius[i] * radius[i];
-    const double couple_norm = 1.0 / std::sqrt(rmass[i] * irot);
-    double kn_sum = 0.0, ks_sum = 0.0, rot_sum = 0.0, couple_sum = 0.0;
+    double sum = 0.0;
     for (int k = 0; k < nbond_[i]; ++k) {
       const int j = partner_index(i, static_cast<int>(bonds_[i][k * NCOL + PARTNER]));
       const double l0 = bonds_[i][k * NCOL + L0];
       const double rb = radius_multiplier_ * std::min(radius[i], radius[j]);
       const double area = kPi * rb * rb, inertia = 0.25 * area * rb * rb;
       const double kn = modulus_ / l0, ks = kn / stiffness_ratio_;
-      const double arm = l0 * radius[i] / (radius[i] + radius[j]);
-      kn_sum += kn * area;
-      ks_sum += ks * area;
-      rot_sum += ks * area * arm * arm + kn * inertia;
-      couple_sum += ks * area * arm;
+      const double arm_i = l0 * radius[i] / (radius[i] + radius[j]), arm_j = l0 - arm_i;
+      const double inv_m = 1.0 / rmass[i] + 1.0 / rmass[j];
+      const double inv_ii = 1.0 / (0.4 * rmass[i] * radius[i] * radius[i]);
+      const double inv_ij = 1.0 / (0.4 * rmass[j] * radius[j] * radius[j]);
+      const double w2_axial = kn * area * inv_m;
+      const double w2_twist = ks * 2.0 * inertia * (inv_ii + inv_ij);
+      const double a = ks * area * (inv_m + arm_i * arm_i * inv_ii + arm_j * arm_j * inv_ij);
+      const double c = kn * inertia * (inv_ii + inv_ij);
+      const double gh = arm_i * inv_ii - arm_j * inv_ij;
+      const double w2_bend =
+          0.5 * (a + c) + std::sqrt(0.25 * (a - c) * (a - c) + ks * area * kn * inertia * gh * gh);
+      sum += std::max({w2_axial, w2_twist, w2_bend});
     }
-    const double w2_normal = 2.0 * kn_sum / rmass[i];
-    const double w2_shear = 2.0 * ks_sum / rmass[i] + 2.0 * couple_sum * couple_norm;
-    const double w2_rot = 2.0 * rot_sum / irot + 2.0 * couple_sum * couple_norm;
-    local[0] = std::min(local[0], 2.0 / std::sqrt(std::max(w2_normal, w2_shear)));
-    local[1] = std::min(local[1], 2.0 / std::sqrt(w2_rot));
+    local = std::max(local, sum);
   }
-  double global[2];
-  MPI_Allreduce(local, global, 2, MPI_DOUBLE, MPI_MIN, world);
-  if (global[0] >= 1e300) {
+  double global = 0.0;
+  MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_MAX, world);
+  if (global <= 0.0) {
     dt_crit_ = 0.0;
     return;
   }
-  dt_crit_ = std::min(global[0], global[1]);
+  dt_crit_ = 2.0 / std::sqrt(global);
   char line[256];
   snprintf(line, sizeof(line),
-           "fix bond/breakable: critical time step of bond springs %.4g s (translational %.4g s, "
-           "rotational %.4g s); time step %.4g s",
-           dt_crit_, global[0], global[1], update->dt);
+           "fix bond/breakable: critical time step of bond springs %.4g s; time step %.4g s",
+           dt_crit_, update->dt);
   message(line);
   if (update->dt > dt_crit_ && comm->me == 0) {
     snprintf(line, sizeof(line),
@@ -892,7 +1014,9 @@ void FixBondBreakable::write_restart(FILE *fp) {
                          static_cast<double>(bonds_created_),
                          broken_tension_,
                          broken_shear_,
-                         lmax_};
+                         lmax_,
+                         moment_factor_,
+                         broken_contact_ ? 1.0 : 0.0};
   const int n = sizeof(list) / sizeof(list[0]);
   if (comm->me == 0) {
     int size = n * sizeof(double);
@@ -907,13 +1031,16 @@ void FixBondBreakable::restart(char *buf) {
   const double *list = reinterpret_cast<double *>(buf);
   const char *names[] = {"radius_multiplier", "modulus",  "stiffness_ratio",
                          "tensile_strength",  "cohesion", "friction_angle",
-                         "damping",           "gap",      "max_bonds"};
-  double *mine[] = {&radius_multiplier_, &modulus_,        &stiffness_ratio_, &tensile_strength_,
-                    &cohesion_,          &friction_angle_, &damping_,         &gap_};
-  for (int k = 0; k < 8; ++k)
-    if (*mine[k] != list[k] && comm->me == 0) {
+                         "damping",           "gap",      "moment_factor"};
+  double *mine[] = {&radius_multiplier_, &modulus_,        &stiffness_ratio_,
+                    &tensile_strength_,  &cohesion_,       &friction_angle_,
+                    &damping_,           &gap_,            &moment_factor_};
+  const double theirs[] = {list[0], list[1], list[2], list[3], list[4],
+                           list[5], list[6], list[7], list[13]};
+  for (int k = 0; k < 9; ++k)
+    if (*mine[k] != theirs[k] && comm->me == 0) {
       std::string m = std::string("fix bond/breakable: ") + names[k] + " " + fmt_num(*mine[k]) +
-                      " differs from the restart file (" + fmt_num(list[k]) +
+                      " differs from the restart file (" + fmt_num(theirs[k]) +
                       "); using the deck's value";
       error->warning(FLERR, m.c_str());
     }
@@ -926,6 +1053,13 @@ void FixBondBreakable::restart(char *buf) {
   broken_tension_ = list[10];
   broken_shear_ = list[11];
   lmax_ = list[12];
+  if ((list[14] != 0.0) != broken_contact_) {
+    // Contacts stored in the file would be read as bonds (or the reverse).
+    std::string m = std::string("fix bond/breakable: broken_contact ") +
+                    (broken_contact_ ? "yes" : "no") + " differs from the restart file (" +
+                    (list[14] != 0.0 ? "yes" : "no") + "); give the same value";
+    error->all(FLERR, m.c_str());
+  }
 }
 
 // Grows per-atom storage to nmax atoms.
@@ -956,7 +1090,7 @@ void FixBondBreakable::set_arrays(int i) {
   count_[i] = 0.0;
 }
 
-// Columns: nbond, then nbond x (PARTNER L0 FS[3] MB[3] MT).
+// Columns: nbond, then nbond x (PARTNER L0 FS[3] MB[3] MT STATE).
 int FixBondBreakable::pack_exchange(int i, double *buf) {
   buf[0] = nbond_[i];
   std::memcpy(&buf[1], bonds_[i], nbond_[i] * NCOL * sizeof(double));
@@ -968,11 +1102,11 @@ int FixBondBreakable::unpack_exchange(int nlocal, double *buf) {
   if (nlocal >= nmax_) grow_arrays(atom->nmax);
   nbond_[nlocal] = static_cast<int>(buf[0]);
   std::memcpy(bonds_[nlocal], &buf[1], nbond_[nlocal] * NCOL * sizeof(double));
-  count_[nlocal] = nbond_[nlocal];
+  count_[nlocal] = intact_bonds(nlocal);
   return 1 + nbond_[nlocal] * NCOL;
 }
 
-// Restart columns: size, nbond, then nbond x (PARTNER L0 FS[3] MB[3] MT).
+// Restart columns: size, nbond, then nbond x (PARTNER L0 FS[3] MB[3] MT STATE).
 int FixBondBreakable::pack_restart(int i, double *buf) {
   buf[0] = 2 + nbond_[i] * NCOL;
   buf[1] = nbond_[i];
@@ -994,7 +1128,7 @@ void FixBondBreakable::unpack_restart(int nlocal, int nth) {
   }
   nbond_[nlocal] = nb;
   std::memcpy(bonds_[nlocal], &extra[nlocal][m], nb * NCOL * sizeof(double));
-  count_[nlocal] = nb;
+  count_[nlocal] = intact_bonds(nlocal);
 }
 
 // Restart size of atom nlocal.

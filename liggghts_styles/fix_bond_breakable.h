@@ -53,8 +53,9 @@ class FixBondBreakable : public Fix {
   double memory_usage() override;
 
   // Per-bond columns stored per atom and slot: partner tag, initial length L0,
-  // shear force (3), bending moment (3), twisting moment (1). Canonical frame.
-  enum Column { PARTNER = 0, L0, FS, MB = FS + 3, MT = MB + 3, NCOL };
+  // shear force (3), bending moment (3), twisting moment (1), state (0 intact
+  // bond, 1 broken bond kept as a compression-only contact). Canonical frame.
+  enum Column { PARTNER = 0, L0, FS, MB = FS + 3, MT = MB + 3, STATE, NCOL };
 
  private:
   // Parameters (SI units, see the doc page).
@@ -65,6 +66,8 @@ class FixBondBreakable : public Fix {
   double cohesion_ = 0.0;           // c                                         [Pa]
   double friction_angle_ = 0.0;     // phi                                       [deg]
   double damping_ = 0.0;            // fraction of critical damping              [-]
+  double moment_factor_ = 1.0;      // beta, moment share of the bond stresses   [-]
+  bool broken_contact_ = false;     // keep broken bonds as compression contacts
   double gap_ = 0.1;                // bonding tolerance, x min radius           [-]
   int max_bonds_ = 16;              // slots per atom
   std::string break_log_path_;
@@ -116,7 +119,8 @@ class FixBondBreakable : public Fix {
   bool list_valid_ = false;
   bigint list_ncalls_ = -1;  // neighbor->ncalls when the list was built
   int list_nlocal_ = -1, list_nghost_ = -1;
-  std::vector<int> broken_;  // bonds broken this step: i, j, tag i, partner tag
+  std::vector<int> broken_;   // slots to remove this step: i, j, tag i, partner tag
+  std::vector<int> contact_;  // bonds that became contacts this step: list entries
 
   struct BondResult;
   struct AtomArrays;
@@ -127,8 +131,11 @@ class FixBondBreakable : public Fix {
   void compute_bonds(bool advance);
   void evaluate_bond(const AtomArrays &at, const ListedBond &bond, bool advance,
                      BondResult &out) const;
+  bool evaluate_contact(const AtomArrays &at, const ListedBond &bond, bool advance,
+                        BondResult &out) const;
   void remove_slot(int i, int slot);
   int find_slot(int i, int partner_tag) const;
+  int intact_bonds(int i) const;
   int partner_index(int i, int partner_tag) const;
   void estimate_time_step();
   void write_bond_dump();
