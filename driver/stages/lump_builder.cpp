@@ -25,16 +25,17 @@ LumpSpec lump_spec(const config::CaseConfig& cfg) {
           cfg.ore.real("density"),      cfg.ore.real("poisson_ratio")};
 }
 
-namespace {
 // The five radius classes of the builder deck, relative to the mean.
 double class_factor(int k, double spread) { return 1.0 + spread * (k - 2) / 2.0; }
 
+// Mean of (r / r_mean)^3 over the five classes.
 double mean_cube_factor(double spread) {
   double s = 0;
   for (int k = 0; k < 5; ++k) s += std::pow(class_factor(k, spread), 3);
   return s / 5.0;
 }
 
+namespace {
 bool is_prime(long n) {
   if (n < 2) return false;
   for (long i = 2; i * i <= n; ++i)
@@ -45,13 +46,6 @@ long next_prime(long n) {
   while (!is_prime(n)) ++n;
   return n;
 }
-// LIGGGHTS wants distinct prime seeds > 10000; the deck's own templates use 10007-10061.
-long prime_seed(long base) {
-  long n = 20000 + (base % 1000000) * 7;
-  while (!is_prime(n)) ++n;
-  return n;
-}
-
 // Exclusive lock on a file for the lifetime of the object.
 class FileLock {
  public:
@@ -73,6 +67,13 @@ class FileLock {
   int fd_ = -1;
 };
 }  // namespace
+
+// LIGGGHTS wants distinct prime seeds > 10000; the deck's own templates use 10007-10061.
+long prime_seed(long base) {
+  long n = 20000 + (base % 1000000) * 7;
+  while (!is_prime(n)) ++n;
+  return n;
+}
 
 double target_mean_radius(long n, double diameter, double spread) {
   const double R = diameter / 2;

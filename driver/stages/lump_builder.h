@@ -35,6 +35,14 @@ struct LumpSpec {
 
 LumpSpec lump_spec(const config::CaseConfig& cfg);
 
+// The five radius classes of the builder deck, relative to the mean.
+double class_factor(int k, double spread);
+// Mean of (r / r_mean)^3 over the five classes.
+double mean_cube_factor(double spread);
+// A prime > 20000 from a seed (LIGGGHTS wants distinct primes > 10000 for its
+// random fixes, and aborts without a message when two share one).
+long prime_seed(long base);
+
 // Mean element radius for N elements to fill a ball of the given diameter,
 // with the solid fraction of a random packing in its bounding sphere
 // (0.62 (1 - 1.23 N^(-1/3))^3, fitted to this builder; the rest follows).

@@ -1,0 +1,111 @@
+// The calibrate stage's fitting scheme: score, update, best iteration.
+#include "stages/calibrate/fitting.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "postprocess/lab_tests.h"
+
+namespace mill::calibrate {
+
+// Errors of one iteration against the ore card and whether all are met.
+void Fitting::score(Iteration& it) const {
+  it.err_E = post::RelativeError(it.ucs.r.youngs_modulus, t_.E);
+  it.err_ucs = post::RelativeError(it.ucs.r.ucs, t_.ucs);
+  it.err_t = post::RelativeError(it.br.r.tensile_strength, t_.tensile);
+  it.err_nu = std::abs(it.ucs.r.poisson_ratio - t_.nu);
+  it.score =
+      std::max({it.err_E / tol_, it.err_ucs / tol_, it.err_t / tol_, it.err_nu / kNuTolerance});
+  it.converged = it.score <= 1.0;
+}
+
+// Next micro parameters: one damped log-space secant step per parameter,
+// each driven by its own macro property (bond modulus -> E, stiffness ratio
+// -> nu, bond tensile strength -> Brazilian strength, cohesion -> UCS), all
+// from the same pair of tests. The friction angle stays at its estimate.
+BondParams Fitting::update(const std::vector<Iteration>& hist,
+                           std::vector<std::string>& notes) const {
+  const Iteration& now = hist.back();
+  const Iteration* prev = hist.size() > 1 ? &hist[hist.size() - 2] : nullptr;
+  auto pt = [](double x, double y) { return post::SecantPoint{x, y}; };
+  auto prev_pt = [&](double x, double y) -> std::optional<post::SecantPoint> { return pt(x, y); };
+  BondParams p = now.p;
+  // E scales with the bond modulus (all bond springs do), so the slope is near 1.
+  const post::SecantRule e_rule{true, 1.0, 0.5, 1.5, std::log(4.0)};
+  // nu rises with kn/ks; about +0.1 per e-fold at these ratios (first guess).
+  const post::SecantRule nu_rule{false, 0.1, 0.02, 0.5, 0.7};
+  // Strengths scale with bond strengths when the failure mode stays the same
+  // (the closed-form start can be an order of magnitude off: wide cap).
+  const post::SecantRule s_rule{true, 1.0, 0.3, 2.0, std::log(16.0)};
+  p.modulus = post::SecantUpdate(
+                  e_rule, pt(now.p.modulus, now.ucs.r.youngs_modulus),
+                  prev ? prev_pt(prev->p.modulus, prev->ucs.r.youngs_modulus) : std::nullopt, t_.E)
+                  .x_new;
+  p.stiffness_ratio = std::clamp(
+      post::SecantUpdate(
+          nu_rule, pt(now.p.stiffness_ratio, now.ucs.r.poisson_ratio),
+          prev ? prev_pt(prev->p.stiffness_ratio, prev->ucs.r.poisson_ratio) : std::nullopt, t_.nu)
+          .x_new,
+      0.5, 20.0);
+  p.tensile =
+      post::SecantUpdate(
+          s_rule, pt(now.p.tensile, now.br.r.tensile_strength),
+          prev ? prev_pt(prev->p.tensile, prev->br.r.tensile_strength) : std::nullopt, t_.tensile)
+          .x_new;
+  // Cohesion acts on the UCS through the ratio c / sigma_b (the tensile lever
+  // moves both strengths). It moves last, once E and the tensile strength are
+  // within tolerance (most sensitive first), in damped steps: below
+  // c ~ sigma_b shear failures weaken the Brazilian disc too.
+  const double ratio_now = now.p.cohesion / now.p.tensile;
+  double ratio = ratio_now;
+  if (now.err_E <= tol_ && now.err_t <= tol_) {
+    const post::SecantRule c_rule{true, 1.0, 0.5, 2.0, std::log(2.0)};
+    const bool prev_moved =
+        prev && std::abs(std::log(prev->p.cohesion / prev->p.tensile / ratio_now)) > 1e-6;
+    ratio = post::SecantUpdate(c_rule, pt(ratio_now, now.ucs.r.ucs / now.br.r.tensile_strength),
+                               prev_moved ? prev_pt(prev->p.cohesion / prev->p.tensile,
+                                                    prev->ucs.r.ucs / prev->br.r.tensile_strength)
+                                          : std::nullopt,
+                               t_.ucs / t_.tensile)
+                .x_new;
+  }
+  if (ratio > kMaxCohesionRatio) {
+    ratio = kMaxCohesionRatio;
+    notes.push_back(
+        fmt::format("cohesion capped at {:g} x the bond tensile strength", kMaxCohesionRatio));
+  }
+  p.cohesion = ratio * p.tensile;
+  p.origin = "calibrate iteration " + std::to_string(hist.size() + 1);
+  return p;
+}
+
+// The best iteration: most targets within tolerance, then the smallest
+// worst error (in tolerance units): an unreachable target must not hide
+// the iteration that meets the others.
+size_t Fitting::best(const std::vector<Iteration>& hist) const {
+  auto met = [&](const Iteration& it) {
+    return (it.err_E <= tol_) + (it.err_ucs <= tol_) + (it.err_t <= tol_) +
+           (it.err_nu <= kNuTolerance);
+  };
+  size_t best = 0;
+  for (size_t i = 1; i < hist.size(); ++i)
+    if (met(hist[i]) > met(hist[best]) ||
+        (met(hist[i]) == met(hist[best]) && hist[i].score < hist[best].score))
+      best = i;
+  return best;
+}
+
+// The ore card's calibrated.* values in place of those of base.
+BondParams card_calibration(const config::Document& ore, BondParams base) {
+  base.modulus = ore.real("calibrated.bond_modulus");
+  base.stiffness_ratio = ore.real("calibrated.stiffness_ratio");
+  base.tensile = ore.real("calibrated.bond_tensile_strength");
+  base.cohesion = ore.real("calibrated.bond_cohesion");
+  base.friction_angle_deg = ore.real("calibrated.bond_friction_angle");
+  return base;
+}
+
+}  // namespace mill::calibrate

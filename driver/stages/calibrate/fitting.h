@@ -1,0 +1,55 @@
+// The fitting scheme of the calibrate stage (docs/calibration.md, "Fitting
+// scheme"): the errors of an iteration against the ore card, the next bond
+// parameters (one damped secant step per parameter), and the iteration kept
+// as the result. A change here changes what a calibration gives: bump
+// kDeckVersion in calibrate_stage.cpp.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "stages/calibrate/lab_runs.h"
+#include "stages/material.h"
+
+namespace mill::calibrate {
+
+// Tolerance on Poisson's ratio (absolute).
+inline constexpr double kNuTolerance = 0.05;
+// Cap on cohesion / bond tensile strength (the UCS lever).
+inline constexpr double kMaxCohesionRatio = 50.0;
+
+// One iteration: the bond parameters tried, both tests, their errors.
+struct Iteration {
+  BondParams p;
+  UcsRun ucs;
+  BrazilianRun br;
+  double err_E = 0, err_ucs = 0, err_t = 0, err_nu = 0;
+  bool converged = false;
+  double score = 0;  // worst error in units of its tolerance
+};
+
+// Fits to the targets within relative tolerance tol (nu: kNuTolerance).
+class Fitting {
+ public:
+  Fitting(const Targets& t, double tol) : t_(t), tol_(tol) {}
+  const Targets& targets() const { return t_; }
+  double tolerance() const { return tol_; }
+
+  // Errors of one iteration against the ore card and whether all are met.
+  void score(Iteration& it) const;
+  // Next micro parameters from the iterations so far.
+  BondParams update(const std::vector<Iteration>& hist, std::vector<std::string>& notes) const;
+  // Index of the iteration kept as the result.
+  size_t best(const std::vector<Iteration>& hist) const;
+
+ private:
+  Targets t_;
+  double tol_;
+};
+
+// The ore card's calibrated.* values in place of those of base (the rest of
+// base kept): the fit's start when the card's section is stale.
+BondParams card_calibration(const config::Document& ore, BondParams base = {});
+
+}  // namespace mill::calibrate

@@ -1,0 +1,78 @@
+// The virtual lab tests of the calibrate stage: the UCS and Brazilian decks
+// (liggghts_inputs/{ucs,brazilian}.in.tmpl) run on the carved specimens, their
+// curves read and analysed (docs/calibration.md, steps 3 and 4).
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "engine/runner.h"
+#include "postprocess/lab_tests.h"
+#include "stages/calibrate/specimen.h"
+#include "stages/material.h"
+#include "stages/stage.h"
+
+namespace mill::calibrate {
+
+// The ore card's macro properties: what the lab tests measure and the fit aims at.
+struct Targets {
+  double E, nu, ucs, tensile;
+};
+
+// What every lab test gives: the deck's info line and load curve.
+struct LabRun {
+  std::map<std::string, double> info;
+  std::filesystem::path info_file;  // where `info` was read (named in errors)
+  post::LoadCurve curve;
+  double seconds = 0;
+  bool peaked = true;  // false: the run reached its strain cap still loading
+};
+
+struct UcsRun : LabRun {
+  post::UcsResult r;
+  post::StressStrain ss;
+  double area = 0, gauge = 0;
+};
+
+struct BrazilianRun : LabRun {
+  post::BrazilianResult r;
+};
+
+// One run of a lab test: its folder <dir>/runs/<tag>, what the progress line
+// shows, and the fraction of the job done before it.
+struct RunStep {
+  std::string tag, what;
+  double done = 0;
+};
+
+// Runs the lab tests of one calibration job on its specimens.
+class LabBench {
+ public:
+  LabBench(StageContext& ctx, const std::string& job_label, const std::filesystem::path& dir,
+           const Specimen& sp, const Targets& t)
+      : ctx_(ctx), job_label_(job_label), dir_(dir), sp_(sp), t_(t) {}
+
+  // A UCS test with bond parameters p at the given strain rate.
+  UcsRun ucs(const BondParams& p, double rate, const RunStep& step);
+  // A Brazilian test with bond parameters p at the given strain rate.
+  BrazilianRun brazilian(const BondParams& p, double rate, const RunStep& step);
+
+ private:
+  struct Test;
+  void run_test(const Test& test, const BondParams& p, double rate, const RunStep& step,
+                LabRun& out);
+  engine::Result run_lab_deck(const std::string& deck, const std::filesystem::path& work,
+                              std::vector<std::pair<std::string, std::string>> vars,
+                              const RunStep& step);
+
+  StageContext& ctx_;
+  std::string job_label_;
+  std::filesystem::path dir_;
+  Specimen sp_;
+  Targets t_;
+};
+
+}  // namespace mill::calibrate

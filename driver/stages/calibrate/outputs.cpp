@@ -1,0 +1,446 @@
+// Outputs of the calibration job: calibrated.yaml, reports, curves, plots.
+#include "stages/calibrate/outputs.h"
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "engine/runner.h"
+#include "jobs/job_store.h"
+#include "progress.h"
+
+namespace mill::calibrate {
+namespace fs = std::filesystem;
+
+namespace {
+
+// Bond parameters as JSON, with the calibrated.yaml key names.
+nlohmann::json bond_json(const BondParams& b) {
+  return {{"bond_modulus", b.modulus},
+          {"stiffness_ratio", b.stiffness_ratio},
+          {"bond_tensile_strength", b.tensile},
+          {"bond_cohesion", b.cohesion},
+          {"bond_friction_angle", b.friction_angle_deg},
+          {"radius_multiplier", b.radius_multiplier}};
+}
+
+// The macro properties an iteration achieved, with the ore card's key names.
+nlohmann::json macro(const Iteration& it) {
+  return nlohmann::json{{"youngs_modulus", it.ucs.r.youngs_modulus},
+                        {"poisson_ratio", it.ucs.r.poisson_ratio},
+                        {"ucs", it.ucs.r.ucs},
+                        {"tensile_strength", it.br.r.tensile_strength}};
+}
+
+// A value of a run's info line, 0 when the deck did not write it.
+double info_or_zero(const std::map<std::string, double>& m, const char* k) {
+  auto it = m.find(k);
+  return it == m.end() ? 0.0 : it->second;
+}
+
+// One row per sample of every test run, for the plots and spreadsheets.
+void append_curves(std::ostream& o, const std::string& run, int iteration, const std::string& test,
+                   double rate, const post::LoadCurve& c, const std::vector<double>& strain,
+                   const std::vector<double>& stress) {
+  for (size_t i = 0; i < c.size(); ++i)
+    o << fmt::format("{},{},{},{:.6g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", run, iteration, test,
+                     rate, c.displacement[i], c.force(i), strain[i], stress[i],
+                     c.lateral_strain[i]);
+}
+
+// The calibrated: map that material.cpp reads (and that may be pasted into
+// the ore card), fitted to the card whose ore_hash is `hash`.
+void emit_calibrated(YAML::Emitter& y, const BondParams& b, const std::string& hash) {
+  y << YAML::Key << "calibrated" << YAML::Value << YAML::BeginMap;
+  y << YAML::Key << "bond_modulus" << YAML::Value << b.modulus;
+  y << YAML::Key << "stiffness_ratio" << YAML::Value << b.stiffness_ratio;
+  y << YAML::Key << "bond_tensile_strength" << YAML::Value << b.tensile;
+  y << YAML::Key << "bond_cohesion" << YAML::Value << b.cohesion;
+  y << YAML::Key << "bond_friction_angle" << YAML::Value << b.friction_angle_deg;
+  y << YAML::Key << "input_hash" << YAML::Value << hash;
+  y << YAML::EndMap;
+}
+
+// The outputs of one finished fit, each built from the same facts.
+class Report {
+ public:
+  // What the outputs say about fit `o` to the case's ore card.
+  Report(const config::CaseConfig& cfg, const Fitting& fit, const Outcome& o)
+      : d_(cfg.doc),
+        ore_(cfg.ore),
+        t_(fit.targets()),
+        tol_(fit.tolerance()),
+        rate_(cfg.doc.real("calibrate.strain_rate")),
+        n_(cfg.doc.integer("calibrate.n_elements")),
+        sp_(o.specimen),
+        hist_(o.hist),
+        best_(o.best),
+        b_(o.hist[o.best]),
+        half_(o.half),
+        wall_(o.wall),
+        notes_(o.notes),
+        hash_(ore_hash(cfg.ore)),
+        rate_change_(o.half ? post::RelativeError(o.half->r.ucs, b_.ucs.r.ucs) : 0.0),
+        rate_ok_(rate_change_ < 0.05),
+        ui_(b_.ucs.info),
+        bi_(b_.br.info),
+        missed_(explain_missed()) {}
+
+  // Why each target that was not reached was not, in words.
+  const std::vector<std::string>& missed() const { return missed_; }
+  nlohmann::json json() const;
+  std::string yaml() const;
+  std::string markdown() const;
+  std::string curves() const;
+  std::string summary() const;
+
+ private:
+  std::vector<std::string> explain_missed() const;
+
+  const config::Document& d_;
+  const config::Document& ore_;
+  const Targets t_;
+  const double tol_, rate_;
+  const long n_;
+  const Specimen& sp_;
+  const std::vector<Iteration>& hist_;
+  const size_t best_;
+  const Iteration& b_;
+  const std::optional<UcsRun>& half_;
+  const double wall_;
+  const std::vector<std::string>& notes_;
+  const std::string hash_;
+  const double rate_change_;
+  const bool rate_ok_;
+  const std::map<std::string, double>& ui_;  // info line of the result's UCS run
+  const std::map<std::string, double>& bi_;  // and of its Brazilian run
+  const std::vector<std::string> missed_;
+};
+
+// Why a target was missed, in words (docs/calibration.md explains).
+std::vector<std::string> Report::explain_missed() const {
+  std::vector<std::string> missed;
+  if (b_.err_E > tol_)
+    missed.push_back(fmt::format("E {:.2f} GPa is {:.0f}% off the target after {} iterations",
+                                 b_.ucs.r.youngs_modulus / 1e9, 100 * b_.err_E, hist_.size()));
+  if (b_.err_nu > kNuTolerance)
+    missed.push_back(
+        fmt::format("nu {:.3f} is {:.3f} off the target: kn/ks {:.2f} (kept in [0.5, 20])",
+                    b_.ucs.r.poisson_ratio, b_.err_nu, b_.p.stiffness_ratio));
+  if (b_.err_t > tol_)
+    missed.push_back(fmt::format("tensile strength {:.2f} MPa is {:.0f}% off the target",
+                                 b_.br.r.tensile_strength / 1e6, 100 * b_.err_t));
+  if (b_.err_ucs > tol_) {
+    const double ratio = b_.ucs.r.ucs / b_.br.r.tensile_strength, want = t_.ucs / t_.tensile;
+    // Measured sensitivity of the UCS to the cohesion ratio (last two iterations that moved it).
+    std::string lever;
+    for (size_t i = hist_.size(); i-- > 1;) {
+      const double r1 = hist_[i - 1].p.cohesion / hist_[i - 1].p.tensile,
+                   r2 = hist_[i].p.cohesion / hist_[i].p.tensile;
+      if (std::abs(std::log(r2 / r1)) < 1e-3) continue;
+      lever = fmt::format(
+          "; raising cohesion/tensile from {:.2f} to {:.2f} changed the UCS by {:+.1f}%{}", r1, r2,
+          100 * (hist_[i].ucs.r.ucs / hist_[i - 1].ucs.r.ucs - 1),
+          std::abs(hist_[i].ucs.r.ucs / hist_[i - 1].ucs.r.ucs - 1) < 0.05
+              ? ": the bonds fail in tension (bending included), so the shear strength cannot "
+                "raise the UCS"
+              : "");
+      break;
+    }
+    missed.push_back(post::RelativeError(ratio, want) > tol_
+                         ? fmt::format("UCS {:.1f} MPa is {:.0f}% off the target: UCS/tensile "
+                                       "reached {:.1f} against {:.1f} on "
+                                       "the card (parallel-bond packings of spheres struggle to "
+                                       "pass UCS/tensile ~ 4-10; the "
+                                       "Mohr-Coulomb shear strength, cohesion, is the lever{}{})",
+                                       b_.ucs.r.ucs / 1e6, 100 * b_.err_ucs, ratio, want,
+                                       b_.p.cohesion / b_.p.tensile >= kMaxCohesionRatio * 0.999
+                                           ? ", at its cap"
+                                           : "",
+                                       lever)
+                         : fmt::format("UCS {:.1f} MPa is {:.0f}% off the target (UCS/tensile "
+                                       "{:.1f} is right: the strength level "
+                                       "needs more iterations)",
+                                       b_.ucs.r.ucs / 1e6, 100 * b_.err_ucs, ratio));
+  }
+  return missed;
+}
+
+// report.json: targets, achieved values, every iteration, specimen, rate check.
+nlohmann::json Report::json() const {
+  nlohmann::json iters = nlohmann::json::array();
+  for (size_t i = 0; i < hist_.size(); ++i) {
+    const auto& it = hist_[i];
+    iters.push_back({{"iteration", i + 1},
+                     {"bond", bond_json(it.p)},
+                     {"achieved", macro(it)},
+                     {"errors",
+                      {{"youngs_modulus", it.err_E},
+                       {"poisson_ratio", it.err_nu},
+                       {"ucs", it.err_ucs},
+                       {"tensile_strength", it.err_t}}},
+                     {"within_tolerance", it.converged},
+                     {"ucs_fit_window_Pa", {it.ucs.r.fit_stress_lo, it.ucs.r.fit_stress_hi}},
+                     {"ucs_fit_r2", it.ucs.r.fit.r2},
+                     {"strain_at_peak", it.ucs.r.strain_at_peak},
+                     {"brazilian_peak_force_N", it.br.r.peak_force},
+                     {"ucs_peaked", it.ucs.peaked},
+                     {"brazilian_peaked", it.br.peaked},
+                     {"wall_seconds", it.ucs.seconds + it.br.seconds}});
+  }
+  nlohmann::json specimen = {{"seed", d_.integer("calibrate.seed")},
+                             {"ball_elements", sp_.ball_elements},
+                             {"ball_outer_radius_m", sp_.ball_outer_radius},
+                             {"mean_element_radius_m", sp_.mean_radius},
+                             {"ucs_cylinder",
+                              {{"elements", info_or_zero(ui_, "atoms")},
+                               {"diameter_m", info_or_zero(ui_, "diameter")},
+                               {"height_m", info_or_zero(ui_, "height")},
+                               {"gauge_length_m", info_or_zero(ui_, "gauge_length")},
+                               {"bonds", info_or_zero(ui_, "bonds")},
+                               {"platen_layer_elements", info_or_zero(ui_, "top_layer")}}},
+                             {"brazilian_disc",
+                              {{"elements", info_or_zero(bi_, "atoms")},
+                               {"diameter_m", info_or_zero(bi_, "diameter")},
+                               {"thickness_m", info_or_zero(bi_, "thickness")},
+                               {"bonds", info_or_zero(bi_, "bonds")},
+                               {"jaw_elements", info_or_zero(bi_, "top_layer")}}}};
+  nlohmann::json targets = {{"youngs_modulus", t_.E},
+                            {"poisson_ratio", t_.nu},
+                            {"ucs", t_.ucs},
+                            {"tensile_strength", t_.tensile}};
+  nlohmann::json within = {{"youngs_modulus", b_.err_E <= tol_},
+                           {"poisson_ratio", b_.err_nu <= kNuTolerance},
+                           {"ucs", b_.err_ucs <= tol_},
+                           {"tensile_strength", b_.err_t <= tol_}};
+  nlohmann::json report = {
+      {"ore", ore_.str("name")},
+      {"input_hash", hash_},
+      {"source", "fitted"},
+      {"targets", targets},
+      {"achieved", macro(b_)},
+      {"within_tolerance", within},
+      {"tolerance", {{"relative", tol_}, {"poisson_ratio_absolute", kNuTolerance}}},
+      {"converged", b_.converged},
+      {"best_iteration", best_ + 1},
+      {"iterations", iters},
+      {"calibrated", bond_json(b_.p)},
+      {"specimen", specimen},
+      {"strain_rate_1_s", rate_},
+      {"rate_check", half_ ? nlohmann::json{{"strain_rate_1_s", 0.5 * rate_},
+                                            {"ucs", half_->r.ucs},
+                                            {"youngs_modulus", half_->r.youngs_modulus},
+                                            {"ucs_change", rate_change_},
+                                            {"youngs_modulus_change",
+                                             post::RelativeError(half_->r.youngs_modulus,
+                                                                 b_.ucs.r.youngs_modulus)},
+                                            {"below_5_percent", rate_ok_},
+                                            {"wall_seconds", half_->seconds}}
+                           : nlohmann::json(nullptr)},
+      {"not_reached", missed_},
+      {"notes", notes_},
+      {"wall_seconds", wall_}};
+  return report;
+}
+
+// calibrated.yaml: the calibrated: map is what material.cpp reads (and
+// what may be pasted into the ore card); the rest documents the fit.
+std::string Report::yaml() const {
+  YAML::Emitter y;
+  y.SetDoublePrecision(8);
+  y << YAML::BeginMap;
+  emit_calibrated(y, b_.p, hash_);
+  y << YAML::Key << "ore" << YAML::Value << ore_.str("name");
+  y << YAML::Key << "converged" << YAML::Value << b_.converged;
+  y << YAML::Key << "targets" << YAML::Value << YAML::BeginMap;
+  y << YAML::Key << "youngs_modulus" << YAML::Value << t_.E << YAML::Key << "poisson_ratio"
+    << YAML::Value << t_.nu << YAML::Key << "ucs" << YAML::Value << t_.ucs << YAML::Key
+    << "tensile_strength" << YAML::Value << t_.tensile;
+  y << YAML::EndMap;
+  y << YAML::Key << "achieved" << YAML::Value << YAML::BeginMap;
+  y << YAML::Key << "youngs_modulus" << YAML::Value << b_.ucs.r.youngs_modulus << YAML::Key
+    << "poisson_ratio" << YAML::Value << b_.ucs.r.poisson_ratio << YAML::Key << "ucs" << YAML::Value
+    << b_.ucs.r.ucs << YAML::Key << "tensile_strength" << YAML::Value << b_.br.r.tensile_strength;
+  y << YAML::EndMap;
+  y << YAML::Key << "specimen" << YAML::Value << YAML::BeginMap;
+  y << YAML::Key << "elements" << YAML::Value << n_;
+  y << YAML::Key << "ucs_cylinder_diameter_m" << YAML::Value << info_or_zero(ui_, "diameter");
+  y << YAML::Key << "ucs_cylinder_height_m" << YAML::Value << info_or_zero(ui_, "height");
+  y << YAML::Key << "brazilian_disc_diameter_m" << YAML::Value << info_or_zero(bi_, "diameter");
+  y << YAML::Key << "brazilian_disc_thickness_m" << YAML::Value << info_or_zero(bi_, "thickness");
+  y << YAML::Key << "mean_element_radius_m" << YAML::Value << sp_.mean_radius;
+  y << YAML::Key << "seed" << YAML::Value << d_.integer("calibrate.seed");
+  y << YAML::EndMap;
+  y << YAML::Key << "strain_rate" << YAML::Value << rate_;
+  y << YAML::EndMap;
+  return y.c_str();
+}
+
+// Markdown report: targets against achieved values.
+std::string Report::markdown() const {
+  std::ostringstream md;
+  md << fmt::format("# Calibration of {} ({} elements per specimen)\n\n", ore_.str("name"), n_);
+  md << fmt::format("{} after {} iteration(s); best: iteration {}. Wall time {}.\n\n",
+                    b_.converged ? "All targets within tolerance" : "**Not all targets reached**",
+                    hist_.size(), best_ + 1, Progress::duration(wall_));
+  md << "| property | target | achieved | error | tolerance | ok |\n|---|---|---|---|---|---|\n";
+  md << fmt::format("| E (GPa) | {:.2f} | {:.2f} | {:.1f}% | {:.0f}% | {} |\n", t_.E / 1e9,
+                    b_.ucs.r.youngs_modulus / 1e9, 100 * b_.err_E, 100 * tol_,
+                    b_.err_E <= tol_ ? "yes" : "no");
+  md << fmt::format("| nu | {:.3f} | {:.3f} | {:.3f} | {:.2f} | {} |\n", t_.nu,
+                    b_.ucs.r.poisson_ratio, b_.err_nu, kNuTolerance,
+                    b_.err_nu <= kNuTolerance ? "yes" : "no");
+  md << fmt::format("| UCS (MPa) | {:.1f} | {:.1f} | {:.1f}% | {:.0f}% | {} |\n", t_.ucs / 1e6,
+                    b_.ucs.r.ucs / 1e6, 100 * b_.err_ucs, 100 * tol_,
+                    b_.err_ucs <= tol_ ? "yes" : "no");
+  md << fmt::format("| tensile (MPa) | {:.2f} | {:.2f} | {:.1f}% | {:.0f}% | {} |\n\n",
+                    t_.tensile / 1e6, b_.br.r.tensile_strength / 1e6, 100 * b_.err_t, 100 * tol_,
+                    b_.err_t <= tol_ ? "yes" : "no");
+  md << "## Bond parameters (calibrated.yaml)\n\n| parameter | value |\n|---|---|\n";
+  md << fmt::format(
+      "| bond modulus (GPa) | {:.3f} |\n| kn/ks | {:.3f} |\n| bond tensile strength (MPa) | {:.3f} "
+      "|\n"
+      "| bond cohesion (MPa) | {:.3f} |\n| bond friction angle (deg) | {:.1f} |\n| radius "
+      "multiplier | {:g} |\n\n",
+      b_.p.modulus / 1e9, b_.p.stiffness_ratio, b_.p.tensile / 1e6, b_.p.cohesion / 1e6,
+      b_.p.friction_angle_deg, b_.p.radius_multiplier);
+  md << "## Iterations\n\n| it | E_b (GPa) | kn/ks | sigma_b (MPa) | c (MPa) | E (GPa) | nu | UCS "
+        "(MPa) | tensile (MPa) | "
+        "wall (s) |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (size_t i = 0; i < hist_.size(); ++i) {
+    const auto& it = hist_[i];
+    md << fmt::format(
+        "| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.3f} | {:.2f} | {:.2f} | {:.0f} |\n",
+        i + 1, it.p.modulus / 1e9, it.p.stiffness_ratio, it.p.tensile / 1e6, it.p.cohesion / 1e6,
+        it.ucs.r.youngs_modulus / 1e9, it.ucs.r.poisson_ratio, it.ucs.r.ucs / 1e6,
+        it.br.r.tensile_strength / 1e6, it.ucs.seconds + it.br.seconds);
+  }
+  if (half_)
+    md << fmt::format(
+        "\n## Loading rate\n\nUCS at {:g} 1/s: {:.2f} MPa; at {:g} 1/s: {:.2f} MPa; change {:.1f}% "
+        "({}).\n",
+        rate_, b_.ucs.r.ucs / 1e6, 0.5 * rate_, half_->r.ucs / 1e6, 100 * rate_change_,
+        rate_ok_ ? "below 5%: quasi-static" : "5% or more: lower calibrate.strain_rate");
+  else
+    md << "\n## Loading rate\n\nNot checked (calibrate.rate_check: false).\n";
+  md << fmt::format(
+      "\n## Specimens\n\nCarved from a ball of {} elements (seed {}), mean element radius {:.3f} "
+      "mm (as the "
+      "lump). UCS cylinder: {:g} elements, diameter {:.2f} mm, height {:.2f} mm. Brazilian disc: "
+      "{:g} "
+      "elements, diameter {:.2f} mm, thickness {:.2f} mm.\n",
+      sp_.ball_elements, d_.integer("calibrate.seed"), sp_.mean_radius * 1e3,
+      info_or_zero(ui_, "atoms"), info_or_zero(ui_, "diameter") * 1e3,
+      info_or_zero(ui_, "height") * 1e3, info_or_zero(bi_, "atoms"),
+      info_or_zero(bi_, "diameter") * 1e3, info_or_zero(bi_, "thickness") * 1e3);
+  if (!missed_.empty()) {
+    md << "\n## Not reached\n\n";
+    for (const auto& m : missed_) md << "- " << m << "\n";
+  }
+  if (!notes_.empty()) {
+    md << "\n## Notes\n\n";
+    for (const auto& n : notes_) md << "- " << n << "\n";
+  }
+  return md.str();
+}
+
+// Curves of every run (aggregated; the plots read only this and report.json).
+std::string Report::curves() const {
+  std::ostringstream cv;
+  cv << "run,iteration,test,strain_rate,displacement_m,force_N,strain,stress_Pa,lateral_strain\n";
+  for (size_t i = 0; i < hist_.size(); ++i) {
+    const auto& it = hist_[i];
+    append_curves(cv, fmt::format("it{}_ucs", i + 1), static_cast<int>(i + 1), "ucs", rate_,
+                  it.ucs.curve, it.ucs.ss.strain, it.ucs.ss.stress);
+    const double D = info_or_zero(it.br.info, "diameter"),
+                 th = info_or_zero(it.br.info, "thickness");
+    std::vector<double> strain, stress;
+    for (size_t j = 0; j < it.br.curve.size(); ++j) {
+      strain.push_back(it.br.curve.displacement[j] / D);
+      stress.push_back(post::BrazilianTensileStrength(it.br.curve.force(j), D, th));
+    }
+    append_curves(cv, fmt::format("it{}_brazilian", i + 1), static_cast<int>(i + 1), "brazilian",
+                  rate_, it.br.curve, strain, stress);
+  }
+  if (half_)
+    append_curves(cv, "rate_check_ucs", static_cast<int>(best_ + 1), "ucs", 0.5 * rate_,
+                  half_->curve, half_->ss.strain, half_->ss.stress);
+  return cv.str();
+}
+
+// The one-line result for the log.
+std::string Report::summary() const {
+  return fmt::format(
+      "[calibrate] {}: E {:.2f} GPa, nu {:.3f}, UCS {:.1f} MPa, tensile {:.2f} MPa "
+      "(iteration {}){}",
+      b_.converged ? "converged" : "NOT all targets reached", b_.ucs.r.youngs_modulus / 1e9,
+      b_.ucs.r.poisson_ratio, b_.ucs.r.ucs / 1e6, b_.br.r.tensile_strength / 1e6, best_ + 1,
+      half_ ? fmt::format("; rate check: UCS changes {:.1f}% at half the rate", 100 * rate_change_)
+            : "");
+}
+
+}  // namespace
+
+// calibrated.yaml, report.json, report.md, curves.csv and plots in the job folder.
+void write_outputs(StageContext& ctx, const fs::path& dir, const Fitting& fit, const Outcome& o) {
+  const Report r(ctx.cfg, fit, o);
+  jobs::atomic_write(dir / "curves.csv", r.curves());
+  jobs::atomic_write(dir / "report.json", r.json().dump(2) + "\n");
+  jobs::atomic_write(dir / "report.md", r.markdown());
+  engine::Command c;
+  c.argv = {"/usr/bin/python3",
+            (ctx.cfg.project_dir / "postprocess" / "plot_lab_tests.py").string(),
+            "--curves",
+            (dir / "curves.csv").string(),
+            "--report",
+            (dir / "report.json").string(),
+            "--out",
+            (dir / "plots").string()};
+  c.cwd = dir;
+  c.log = dir / "plots.log";
+  c.job = "calibrate/plots";
+  ctx.runner.run(c);
+  // Last: the file the breakage stage reads.
+  jobs::atomic_write(
+      dir / "calibrated.yaml",
+      "# Bond (micro) parameters fitted by `orchestrate --stage calibrate` (docs/calibration.md).\n"
+      "# The calibrated: map may be pasted into the ore card; input_hash ties it to the card's\n"
+      "# macro properties.\n" +
+          r.yaml() + "\n");
+  ctx.progress.info(r.summary());
+  for (const auto& m : r.missed()) ctx.progress.warn("[calibrate] not reached: " + m);
+}
+
+// The card's own calibrated.* section, copied (no fitting).
+void copy_from_card(StageContext& ctx, const fs::path& dir) {
+  const auto& o = ctx.cfg.ore;
+  const std::string hash = ore_hash(o);
+  YAML::Emitter y;
+  y.SetDoublePrecision(8);
+  y << YAML::BeginMap;
+  emit_calibrated(y, card_calibration(o), hash);
+  y << YAML::Key << "ore" << YAML::Value << o.str("name") << YAML::Key << "source" << YAML::Value
+    << "ore card " + ctx.cfg.ore_file.string() << YAML::EndMap;
+  const nlohmann::json report = {
+      {"ore", o.str("name")},
+      {"input_hash", hash},
+      {"source", "ore card"},
+      {"ore_card", ctx.cfg.ore_file.string()},
+      {"note", "the ore card carries calibrated.* fitted to its own properties: no fitting run"}};
+  jobs::atomic_write(dir / "report.json", report.dump(2) + "\n");
+  jobs::atomic_write(
+      dir / "report.md",
+      fmt::format(
+          "# Calibration of {}\n\nTaken from the ore card {} (its calibrated.input_hash matches "
+          "the card's properties): no virtual lab tests were run.\n",
+          o.str("name"), ctx.cfg.ore_file.string()));
+  jobs::atomic_write(
+      dir / "calibrated.yaml",
+      "# Copied from the ore card's calibrated: section.\n" + std::string(y.c_str()) + "\n");
+}
+
+}  // namespace mill::calibrate
