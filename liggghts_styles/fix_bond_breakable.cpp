@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <sstream>
@@ -177,6 +178,16 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
       const std::string v = val;
       if (v != "yes" && v != "no") fail("broken_contact must be yes or no, got '" + v + "'");
       broken_contact_ = v == "yes";
+    } else if (key == "contact_moment") {
+      const std::string v = val;
+      if (v != "yes" && v != "no") fail("contact_moment must be yes or no, got '" + v + "'");
+      contact_moment_ = v == "yes";
+    } else if (key == "unbonded_fraction") {
+      unbonded_fraction_ = args.real(arg[iarg], val);
+      if (!(unbonded_fraction_ >= 0.0 && unbonded_fraction_ < 1.0))
+        fail("unbonded_fraction must be in [0, 1), got " + std::string(val));
+    } else if (key == "unbonded_seed") {
+      unbonded_seed_ = args.integer(arg[iarg], val, 1, 2147483647);
     } else if (key == "gap") {
       gap_ = args.real(arg[iarg], val);
       if (!(gap_ >= 0.0)) fail("gap must be >= 0, got " + std::string(val));
@@ -196,8 +207,8 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
     } else {
       fail("unknown keyword '" + key +
            "' (expected radius_multiplier, modulus, stiffness_ratio, tensile_strength, cohesion, "
-           "friction_angle, moment_factor, broken_contact, damping, gap, max_bonds, break_log, "
-           "dump_bonds)");
+           "friction_angle, moment_factor, broken_contact, contact_moment, unbonded_fraction, "
+           "unbonded_seed, damping, gap, max_bonds, break_log, dump_bonds)");
     }
     iarg += 2;
   }
@@ -267,6 +278,7 @@ void FixBondBreakable::init() {
 // + radius of the sub-domain face (comm_I.h), so cutghost must reach ~2 L.
 double FixBondBreakable::extend_cut_ghost() {
   double lbond = std::max(lmax_, (2.0 + gap_) * rmax_);
+  if (contacts_on()) lbond += gap_ * rmax_;  // contacts live up to L0 + g min(Ri, Rj)
   lbond *= 1.05;  // bonds stretch before they break (strain at break << 5%)
   return std::max(0.0, 2.0 * lbond - 2.0 * rmin_);
 }
@@ -404,28 +416,40 @@ void FixBondBreakable::create_bonds() {
       for (int k = 0; k < NCOL; ++k) s[k] = 0.0;
       s[PARTNER] = cd.tag;
       s[L0] = cd.dist;
+      if (unbonded_fraction_ > 0.0 && starts_unbonded(tag[i], cd.tag)) s[STATE] = 1.0;
       ++nbond_[i];
     }
   }
 
   // Report: number of bonds and mean coordination of the group.
   double local[3] = {0.0, 0.0, 0.0}, global[3];
+  double slots = 0.0;
   for (int i = 0; i < nlocal; ++i)
     if (mask[i] & groupbit) {
-      local[0] += nbond_[i];
+      local[0] += intact_bonds(i);
+      slots += nbond_[i];
       local[1] += 1.0;
       for (int k = 0; k < nbond_[i]; ++k) local[2] = std::max(local[2], bonds_[i][k * NCOL + L0]);
     }
   MPI_Allreduce(local, global, 2, MPI_DOUBLE, MPI_SUM, world);
   MPI_Allreduce(&local[2], &lmax_, 1, MPI_DOUBLE, MPI_MAX, world);
+  double slots_all = 0.0;
+  MPI_Allreduce(&slots, &slots_all, 1, MPI_DOUBLE, MPI_SUM, world);
   const double nb = 0.5 * global[0];
   const double coord = global[1] > 0.0 ? global[0] / global[1] : 0.0;
-  char line[256];
+  char line[320];
   snprintf(line, sizeof(line),
            "fix bond/breakable: created %.0f bonds among %.0f atoms, mean coordination %.3f "
            "(gap < %g x min radius)",
            nb, global[1], coord, gap_);
   message(line);
+  if (unbonded_fraction_ > 0.0) {
+    snprintf(line, sizeof(line),
+             "fix bond/breakable: %.0f more pairs in bonding range left unbonded "
+             "(unbonded_fraction %g): compression-only frictional contacts",
+             0.5 * (slots_all - global[0]), unbonded_fraction_);
+    message(line);
+  }
 }
 
 // Index of the partner of local atom i for this step (closest periodic image),
@@ -446,10 +470,22 @@ int FixBondBreakable::partner_index(int i, int partner_tag) const {
 
 // Intact bonds of atom i (its slots less the broken bonds kept as contacts).
 int FixBondBreakable::intact_bonds(int i) const {
-  if (!broken_contact_) return nbond_[i];
+  if (!contacts_on()) return nbond_[i];
   int n = 0;
   for (int k = 0; k < nbond_[i]; ++k) n += bonds_[i][k * NCOL + STATE] == 0.0;
   return n;
+}
+
+// True for the pairs created as contacts, not bonds: a hash of the two tags
+// and the seed (the same on both ends and any rank count) below the fraction.
+bool FixBondBreakable::starts_unbonded(int tag_a, int tag_b) const {
+  const uint64_t lo = static_cast<uint64_t>(std::min(tag_a, tag_b));
+  const uint64_t hi = static_cast<uint64_t>(std::max(tag_a, tag_b));
+  uint64_t z = (lo << 32 | hi) + 0x9e3779b97f4a7c15ULL * static_cast<uint64_t>(unbonded_seed_);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;  // splitmix64 finaliser (Steele et al. 2014)
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return static_cast<double>(z >> 11) * 0x1.0p-53 < unbonded_fraction_;
 }
 
 // Slot of the bond to partner_tag in atom i's list, or -1.
@@ -593,14 +629,17 @@ void FixBondBreakable::evaluate_bond(const AtomArrays &at, const ListedBond &bon
   }
 }
 
-// A broken bond kept as a contact (broken_contact yes): while the pair is
-// closer than its bonding distance L0 it pushes back with the bond's normal
-// stiffness, F_n = kn A (L - L0) < 0, and resists sliding with an incremental
-// shear force ks A dU_s capped by Coulomb friction, |F_s| <= tan(phi) |F_n|;
-// no moments, no tension (the crushed cement bears load only in compression,
-// as the linear contact beside a broken parallel bond does in Potyondy &
-// Cundall 2004, sec. 2.2). Returns false once L >= L0: the pair has separated
-// past its initial gap and the contact is dropped.
+// A contact: a broken bond kept (broken_contact yes) or a pair left unbonded
+// at creation (unbonded_fraction). While the pair is closer than its bonding
+// distance L0 it pushes back with the bond's normal stiffness,
+// F_n = kn A (L - L0) < 0, and resists sliding with an incremental shear force
+// ks A dU_s capped by Coulomb friction, |F_s| <= tan(phi) |F_n|; no tension,
+// and moments only with contact_moment yes (capped, below): cement that bears
+// load in compression only, like the
+// unbonded (slit) interfaces of the flat-joint model (Potyondy 2012) and the
+// linear contact left beside a broken parallel bond (Potyondy & Cundall 2004,
+// sec. 2.2). Open (L >= L0) it carries nothing; returns false once the pair
+// has separated past L0 + g min(Ri, Rj), when the contact is dropped.
 bool FixBondBreakable::evaluate_contact(const AtomArrays &at, const ListedBond &bond, bool advance,
                                         BondResult &out) const {
   const int a = bond.a, b = bond.b;
@@ -612,7 +651,13 @@ bool FixBondBreakable::evaluate_contact(const AtomArrays &at, const ListedBond &
   out.mode = 0;
   out.energy = 0.0;
   out.stretch = stretch;
-  if (stretch >= 0.0) return false;
+  if (len > bond.drop_len) return false;
+  if (stretch >= 0.0) {  // open: no force, no stored shear or moment (contact lost)
+    for (int k = 0; k < 3; ++k) out.fa[k] = out.ta[k] = out.tb[k] = 0.0;
+    if (advance)
+      for (int k = FS; k < STATE; ++k) hist[k] = 0.0;
+    return true;
+  }
   const double inv_len = 1.0 / len;
   const double n[3] = {d[0] * inv_len, d[1] * inv_len, d[2] * inv_len};
   const double wa[3] = {at.omega[a][0], at.omega[a][1], at.omega[a][2]};
@@ -654,6 +699,40 @@ bool FixBondBreakable::evaluate_contact(const AtomArrays &at, const ListedBond &
   for (int k = 0; k < 3; ++k) out.fa[k] = -fb[k];
   cross3(ra_vec, out.fa, out.ta);
   cross3(rb_vec, fb, out.tb);
+  if (!contact_moment_) return true;
+
+  // contact_moment yes: the pressed flat interface of radius R also resists
+  // bending and twisting with the bond's stiffnesses (P&C 2004, eq. 6), up to
+  // the moment at which its edge lifts off under the uniform pressure
+  // F_n/A, |M_b| <= |F_n| I/(A R) = |F_n| R/4, and the friction torque of a
+  // uniformly pressed disc, |M_t| <= tan(phi) |F_n| 2R/3 (Johnson 1985,
+  // sec. 7.2); beyond them the interface rocks or spins at that moment.
+  double mb[3] = {hist[MB], hist[MB + 1], hist[MB + 2]};
+  double mt = hist[MT];
+  if (advance) {
+    rotate_onto_plane(mb, n, 0.5 * (dot3(wa, n) + dot3(wb, n)) * at.dt);
+    const double wrel[3] = {wb[0] - wa[0], wb[1] - wa[1], wb[2] - wa[2]};
+    const double wn = dot3(wrel, n);
+    const double kni_dt = bond.kn * bond.inertia * at.dt;
+    for (int k = 0; k < 3; ++k) mb[k] -= kni_dt * (wrel[k] - wn * n[k]);
+    mt -= bond.ks * bond.polar * wn * at.dt;
+  }
+  const double mb_cap = 0.25 * (-fn) * bond.rbond, mb_mag = norm3(mb);
+  if (mb_mag > mb_cap) {
+    const double sc = mb_mag > 0.0 ? mb_cap / mb_mag : 0.0;
+    for (int k = 0; k < 3; ++k) mb[k] *= sc;
+  }
+  const double mt_cap = tan_friction_ * (-fn) * 2.0 * bond.rbond / 3.0;
+  mt = std::max(-mt_cap, std::min(mt_cap, mt));
+  if (advance) {
+    for (int k = 0; k < 3; ++k) hist[MB + k] = mb[k];
+    hist[MT] = mt;
+  }
+  for (int k = 0; k < 3; ++k) {
+    const double m = mb[k] + mt * n[k];
+    out.ta[k] -= m;
+    out.tb[k] += m;
+  }
   return true;
 }
 
@@ -717,6 +796,7 @@ void FixBondBreakable::build_bond_list() {
       // kn = E_b / L0, ks = kn / (kn/ks)  (Potyondy & Cundall 2004, sec. 2.2).
       lb.kn = modulus_ / slot[L0];  // [Pa/m]
       lb.ks = lb.kn * inv_ratio_;   // [Pa/m]
+      lb.drop_len = slot[L0] + gap_ * std::min(radius[lb.a], radius[lb.b]);
       list_.push_back(lb);
     }
   }
@@ -800,9 +880,9 @@ void FixBondBreakable::compute_bonds(bool advance) {
                                        r.tau};
         events_.insert(events_.end(), ev, ev + kEventCols);
       }
-      // A bond broken while compressed stays as a contact (broken_contact
-      // yes); otherwise it is removed after the loop (entries point at slots).
-      if (broken_contact_ && r.stretch < 0.0)
+      // A broken bond stays as a contact (broken_contact yes); otherwise it
+      // is removed after the loop (list entries point at slots).
+      if (broken_contact_)
         contact_.push_back(e);
       else
         remove_later(lb);
@@ -816,7 +896,8 @@ void FixBondBreakable::compute_bonds(bool advance) {
     }
   }
 
-  // Bonds broken in compression become contacts: state 1, no stored load.
+  // Broken bonds become contacts (broken_contact yes): state 1, and the stored
+  // shear force and moments start again from zero.
   for (const int e : contact_) {
     const ListedBond &lb = list_[e];
     for (int k = FS; k < STATE; ++k) lb.hist[k] = 0.0;
@@ -1016,7 +1097,10 @@ void FixBondBreakable::write_restart(FILE *fp) {
                          broken_shear_,
                          lmax_,
                          moment_factor_,
-                         broken_contact_ ? 1.0 : 0.0};
+                         broken_contact_ ? 1.0 : 0.0,
+                         unbonded_fraction_,
+                         static_cast<double>(unbonded_seed_),
+                         contact_moment_ ? 1.0 : 0.0};
   const int n = sizeof(list) / sizeof(list[0]);
   if (comm->me == 0) {
     int size = n * sizeof(double);
@@ -1053,6 +1137,9 @@ void FixBondBreakable::restart(char *buf) {
   broken_tension_ = list[10];
   broken_shear_ = list[11];
   lmax_ = list[12];
+  if (list[15] != unbonded_fraction_ && comm->me == 0)
+    error->warning(FLERR, "fix bond/breakable: unbonded_fraction differs from the restart file; "
+                          "the pairs were chosen when the bonds were created and are kept");
   if ((list[14] != 0.0) != broken_contact_) {
     // Contacts stored in the file would be read as bonds (or the reverse).
     std::string m = std::string("fix bond/breakable: broken_contact ") +

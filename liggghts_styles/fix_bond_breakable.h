@@ -68,6 +68,9 @@ class FixBondBreakable : public Fix {
   double damping_ = 0.0;            // fraction of critical damping              [-]
   double moment_factor_ = 1.0;      // beta, moment share of the bond stresses   [-]
   bool broken_contact_ = false;     // keep broken bonds as compression contacts
+  bool contact_moment_ = false;     // contacts also carry capped moments
+  double unbonded_fraction_ = 0.0;  // share of bonding pairs made contacts only  [-]
+  int unbonded_seed_ = 1;           // seed of the choice of those pairs
   double gap_ = 0.1;                // bonding tolerance, x min radius           [-]
   int max_bonds_ = 16;              // slots per atom
   std::string break_log_path_;
@@ -114,6 +117,7 @@ class FixBondBreakable : public Fix {
     double rbond, area, inertia, polar;  // disc radius [m], A [m^2], I, J [m^4]
     double inv_area, inv_inertia;        // 1/A, 1/I
     double kn, ks;                       // stiffness per area [Pa/m]
+    double drop_len;                     // a contact is dropped beyond this length [m]
   };
   std::vector<ListedBond> list_;
   bool list_valid_ = false;
@@ -136,6 +140,8 @@ class FixBondBreakable : public Fix {
   void remove_slot(int i, int slot);
   int find_slot(int i, int partner_tag) const;
   int intact_bonds(int i) const;
+  bool contacts_on() const { return broken_contact_ || unbonded_fraction_ > 0.0; }
+  bool starts_unbonded(int tag_a, int tag_b) const;
   int partner_index(int i, int partner_tag) const;
   void estimate_time_step();
   void write_bond_dump();

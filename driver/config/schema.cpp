@@ -117,6 +117,8 @@ Schema make_case_schema() {
       at_least(key("lump.bond_gap", T::Real, "", "0.15", "Bond pairs whose gap is below this x min(Ri, Rj) (0.15: coordination ~6.3 at 3344 elements)"), 0),
       at_least(key("lump.max_bonds", T::Int, "", "16", "Cap of bonds per element"), 1),
       positive(key("lump.bond_radius_multiplier", T::Real, "", "1.0", "Bond disc radius = multiplier x min(Ri, Rj)")),
+      key("lump.broken_contact", T::Bool, "", "true",
+          "Broken bonds stay as compression-only frictional contacts while the pair is within its bonding range (fix bond/breakable broken_contact)"),
 
       // --- breakage sweep (stage 2) ---
       choice("breakage.conditions", "sweep", {"sweep", "transport"},
@@ -172,6 +174,7 @@ Schema make_ore_schema() {
       opt(positive(key("calibrated.bond_tensile_strength", T::Real, "Pa", "", "Bond tensile strength"))),
       opt(positive(key("calibrated.bond_cohesion", T::Real, "Pa", "", "Bond shear cohesion"))),
       opt(range(key("calibrated.bond_friction_angle", T::Real, "deg", "", "Bond Mohr-Coulomb friction angle"), 0, false, 90, true)),
+      opt(range(key("calibrated.bond_moment_factor", T::Real, "", "", "Share of the bond moments in the bond stresses (absent: 1)"), 0, true, 1, true)),
       opt(key("calibrated.input_hash", T::String, "", "", "Hash of the macro properties these were fitted to")),
   };
   return s;

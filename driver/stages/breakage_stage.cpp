@@ -39,7 +39,8 @@ namespace {
 
 nlohmann::json bond_json(const BondParams& b) {
   return {{"modulus", b.modulus},   {"stiffness_ratio", b.stiffness_ratio},       {"tensile", b.tensile},
-          {"cohesion", b.cohesion}, {"friction_angle_deg", b.friction_angle_deg}, {"radius_multiplier", b.radius_multiplier}};
+          {"cohesion", b.cohesion}, {"friction_angle_deg", b.friction_angle_deg}, {"radius_multiplier", b.radius_multiplier},
+          {"moment_factor", b.moment_factor}};
 }
 
 // A uniformly random rotation (Shoemake 1992, "Uniform random rotations",
@@ -114,7 +115,9 @@ Plan BreakageStage::plan(const StageContext& ctx) const {
       case_keys(d, {"lump.", "breakage.duration_after_contact", "breakage.timestep", "breakage.quiet_time"});
   base["ore"] = ore_keys(ctx.cfg.ore);
   base["bond"] = bond_json(bond_params_for(ctx.cfg, ctx.run_dir));
-  base["deck_version"] = 3;
+  // 4: bond/breakable with the signed tension criterion, the moment factor and
+  // the exact critical step (Nov 2026): earlier results are not comparable.
+  base["deck_version"] = 4;
   const long repeats = d.integer("breakage.repeats");
   if (d.str("breakage.conditions") == "transport") {
     // Conditions from stage 1: flywheel (and wall) impacts binned by normal speed.
@@ -200,7 +203,7 @@ std::string run_impact(StageContext& ctx, double velocity, double angle, int rep
               {"dump_interval", num(d.real("breakage.dump_interval"))},
               {"bond_gap", num(d.real("lump.bond_gap"))},
               {"max_bonds", std::to_string(d.integer("lump.max_bonds"))}};
-  for (const auto& kv : material_vars(ctx.cfg.ore, bond)) run.vars.push_back(kv);
+  for (const auto& kv : material_vars(ctx.cfg.ore, bond, ctx.cfg.doc)) run.vars.push_back(kv);
   const engine::Result res = engine::run_deck(ctx.runner, run, ctx.progress, label);
 
   // Fragment analysis of the final state.

@@ -25,7 +25,8 @@ namespace {
 using namespace calibrate;
 
 // Bumped when a deck or the fitting scheme changes what a calibration gives.
-constexpr int kDeckVersion = 1;
+// 2 (Nov 2026): signed bond tension, moment factor and friction-angle levers.
+constexpr int kDeckVersion = 2;
 
 const char* kCalibratedKeys[] = {"calibrated.bond_modulus",          "calibrated.stiffness_ratio",
                                  "calibrated.bond_tensile_strength", "calibrated.bond_cohesion",

@@ -26,6 +26,7 @@ BondParams estimate_bond_params(const config::Document& ore, double radius_multi
   b.tensile = 2.0 * ore.real("tensile_strength");
   b.cohesion = 2.0 * b.tensile;
   b.friction_angle_deg = 30.0;
+  b.moment_factor = 1.0;
   b.radius_multiplier = radius_multiplier;
   b.origin = "closed-form estimate (not calibrated: run --stage calibrate)";
   return b;
@@ -43,6 +44,8 @@ bool read_calibrated(const fs::path& file, const std::string& hash, BondParams& 
   b.tensile = c["bond_tensile_strength"].as<double>();
   b.cohesion = c["bond_cohesion"].as<double>();
   b.friction_angle_deg = c["bond_friction_angle"].as<double>();
+  // Absent from calibrations made before Nov 2026 (then always 1).
+  b.moment_factor = c["bond_moment_factor"] ? c["bond_moment_factor"].as<double>() : 1.0;
   b.origin = "calibrated (" + file.string() + ")";
   return true;
 }
@@ -58,7 +61,8 @@ BondParams bond_params_for(const config::CaseConfig& cfg, const fs::path& run_di
   return b;
 }
 
-std::vector<std::pair<std::string, std::string>> material_vars(const config::Document& ore, const BondParams& b) {
+std::vector<std::pair<std::string, std::string>> material_vars(const config::Document& ore, const BondParams& b,
+                                                               const config::Document& doc) {
   using engine::num;
   return {{"E", num(ore.real("youngs_modulus"))},
           {"nu", num(ore.real("poisson_ratio"))},
@@ -70,6 +74,8 @@ std::vector<std::pair<std::string, std::string>> material_vars(const config::Doc
           {"bond_tensile", num(b.tensile)},
           {"bond_cohesion", num(b.cohesion)},
           {"bond_friction", num(b.friction_angle_deg)},
+          {"moment_factor", num(b.moment_factor)},
+          {"broken_contact", doc.boolean("lump.broken_contact") ? "yes" : "no"},
           {"radius_mult", num(b.radius_multiplier)}};
 }
 

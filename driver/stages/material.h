@@ -16,6 +16,7 @@ struct BondParams {
   double tensile = 0;             // bond tensile strength, Pa
   double cohesion = 0;            // bond shear cohesion, Pa
   double friction_angle_deg = 0;  // bond Mohr-Coulomb friction angle, deg
+  double moment_factor = 1.0;     // beta: share of the bond moments in the bond stresses
   double radius_multiplier = 1.0;
   std::string origin;             // where they come from, for reports
 };
@@ -31,7 +32,9 @@ BondParams estimate_bond_params(const config::Document& ore, double radius_multi
 // properties), the closed-form estimates.
 BondParams bond_params_for(const config::CaseConfig& cfg, const std::filesystem::path& run_dir);
 
-// -var pairs of the impact and lab-test decks: contacts and bonds.
-std::vector<std::pair<std::string, std::string>> material_vars(const config::Document& ore, const BondParams& b);
+// -var pairs of the impact and lab-test decks: contacts, bonds, and the bond
+// model's options from the case (lump.broken_contact).
+std::vector<std::pair<std::string, std::string>> material_vars(const config::Document& ore, const BondParams& b,
+                                                               const config::Document& doc);
 
 }  // namespace mill

@@ -24,12 +24,18 @@ void Fitting::score(Iteration& it) const {
 
 // Next micro parameters: one damped log-space secant step per parameter,
 // each driven by its own macro property (bond modulus -> E, stiffness ratio
-// -> nu, bond tensile strength -> Brazilian strength, cohesion -> UCS), all
-// from the same pair of tests. The friction angle stays at its estimate.
+// -> nu, bond tensile strength -> Brazilian strength), all from the same
+// pair of tests, and one UCS/tensile lever (moment factor, friction angle,
+// cohesion ratio) once E and the tensile strength are met.
 BondParams Fitting::update(const std::vector<Iteration>& hist,
                            std::vector<std::string>& notes) const {
   const Iteration& now = hist.back();
   const Iteration* prev = hist.size() > 1 ? &hist[hist.size() - 2] : nullptr;
+  // A lever move (moment factor, friction angle) changes every response
+  // curve: no secant through an iteration made before it.
+  if (prev && (prev->p.moment_factor != now.p.moment_factor ||
+               prev->p.friction_angle_deg != now.p.friction_angle_deg))
+    prev = nullptr;
   auto pt = [](double x, double y) { return post::SecantPoint{x, y}; };
   auto prev_pt = [&](double x, double y) -> std::optional<post::SecantPoint> { return pt(x, y); };
   BondParams p = now.p;
@@ -55,22 +61,41 @@ BondParams Fitting::update(const std::vector<Iteration>& hist,
           s_rule, pt(now.p.tensile, now.br.r.tensile_strength),
           prev ? prev_pt(prev->p.tensile, prev->br.r.tensile_strength) : std::nullopt, t_.tensile)
           .x_new;
-  // Cohesion acts on the UCS through the ratio c / sigma_b (the tensile lever
-  // moves both strengths). It moves last, once E and the tensile strength are
-  // within tolerance (most sensitive first), in damped steps: below
-  // c ~ sigma_b shear failures weaken the Brazilian disc too.
+  // The UCS/tensile ratio: once E and the tensile strength are within
+  // tolerance (most sensitive first), one lever per iteration, in the order
+  // the levers were measured to raise the ratio (bench/README.md, "Rock
+  // strength levers"): the moment factor 1 -> 0 (bending no longer counts
+  // towards failure; Potyondy 2015), then the friction angle to
+  // kMaxFrictionAngle (the Mohr-Coulomb strength rises with compression and
+  // falls with tension), then damped secant steps on the cohesion ratio
+  // c / sigma_b (the tensile lever moves both strengths). A ratio already
+  // above the card's moves only the cohesion.
   const double ratio_now = now.p.cohesion / now.p.tensile;
   double ratio = ratio_now;
-  if (now.err_E <= tol_ && now.err_t <= tol_) {
-    const post::SecantRule c_rule{true, 1.0, 0.5, 2.0, std::log(2.0)};
-    const bool prev_moved =
-        prev && std::abs(std::log(prev->p.cohesion / prev->p.tensile / ratio_now)) > 1e-6;
-    ratio = post::SecantUpdate(c_rule, pt(ratio_now, now.ucs.r.ucs / now.br.r.tensile_strength),
-                               prev_moved ? prev_pt(prev->p.cohesion / prev->p.tensile,
-                                                    prev->ucs.r.ucs / prev->br.r.tensile_strength)
-                                          : std::nullopt,
-                               t_.ucs / t_.tensile)
-                .x_new;
+  const double want = t_.ucs / t_.tensile;
+  const double have = now.ucs.r.ucs / now.br.r.tensile_strength;
+  if (now.err_E <= tol_ && now.err_t <= tol_ && post::RelativeError(have, want) > tol_) {
+    if (have < want && p.moment_factor > 0.0) {
+      p.moment_factor = 0.0;
+      notes.push_back(fmt::format(
+          "iteration {}: UCS/tensile {:.2f} (card {:.1f}): moment factor {:g} -> 0", hist.size(),
+          have, want, now.p.moment_factor));
+    } else if (have < want && p.friction_angle_deg < kMaxFrictionAngle) {
+      p.friction_angle_deg = kMaxFrictionAngle;
+      notes.push_back(fmt::format(
+          "iteration {}: UCS/tensile {:.2f} (card {:.1f}): bond friction angle {:g} -> {:g} deg",
+          hist.size(), have, want, now.p.friction_angle_deg, kMaxFrictionAngle));
+    } else {
+      const post::SecantRule c_rule{true, 1.0, 0.5, 2.0, std::log(2.0)};
+      const bool prev_moved =
+          prev && std::abs(std::log(prev->p.cohesion / prev->p.tensile / ratio_now)) > 1e-6;
+      ratio = post::SecantUpdate(c_rule, pt(ratio_now, have),
+                                 prev_moved ? prev_pt(prev->p.cohesion / prev->p.tensile,
+                                                      prev->ucs.r.ucs / prev->br.r.tensile_strength)
+                                            : std::nullopt,
+                                 want)
+                  .x_new;
+    }
   }
   if (ratio > kMaxCohesionRatio) {
     ratio = kMaxCohesionRatio;
@@ -105,6 +130,8 @@ BondParams card_calibration(const config::Document& ore, BondParams base) {
   base.tensile = ore.real("calibrated.bond_tensile_strength");
   base.cohesion = ore.real("calibrated.bond_cohesion");
   base.friction_angle_deg = ore.real("calibrated.bond_friction_angle");
+  base.moment_factor =
+      ore.has("calibrated.bond_moment_factor") ? ore.real("calibrated.bond_moment_factor") : 1.0;
   return base;
 }
 

@@ -16,8 +16,12 @@ namespace mill::calibrate {
 
 // Tolerance on Poisson's ratio (absolute).
 inline constexpr double kNuTolerance = 0.05;
-// Cap on cohesion / bond tensile strength (the UCS lever).
+// Cap on cohesion / bond tensile strength (the last UCS/tensile lever).
 inline constexpr double kMaxCohesionRatio = 50.0;
+// Friction angle the UCS/tensile lever raises the bond's to [deg]: tan 60 =
+// 1.73; above it tau_c = c - sigma_n tan(phi) leaves little shear strength
+// under tension.
+inline constexpr double kMaxFrictionAngle = 60.0;
 
 // One iteration: the bond parameters tried, both tests, their errors.
 struct Iteration {

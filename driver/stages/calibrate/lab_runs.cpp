@@ -67,7 +67,7 @@ engine::Result LabBench::run_lab_deck(const std::string& deck, const fs::path& w
 void LabBench::run_test(const Test& test, const BondParams& p, double rate, const RunStep& step,
                         LabRun& out) {
   const config::Document& d = ctx_.cfg.doc;
-  auto vars = material_vars(ctx_.cfg.ore, p);
+  auto vars = material_vars(ctx_.cfg.ore, p, ctx_.cfg.doc);
   for (auto kv : std::initializer_list<std::pair<std::string, std::string>>{
            {"specimen_file", fs::absolute(sp_.ball).string()},
            {"carve_r", num(test.carve_r)},
