@@ -117,7 +117,7 @@ Schema make_case_schema() {
       at_least(key("lump.bond_gap", T::Real, "", "0.15", "Bond pairs whose gap is below this x min(Ri, Rj) (0.15: coordination ~6.3 at 3344 elements)"), 0),
       at_least(key("lump.max_bonds", T::Int, "", "16", "Cap of bonds per element"), 1),
       positive(key("lump.bond_radius_multiplier", T::Real, "", "1.0", "Bond disc radius = multiplier x min(Ri, Rj)")),
-      key("lump.broken_contact", T::Bool, "", "true",
+      key("lump.broken_contact", T::Bool, "", "false",
           "Broken bonds stay as compression-only frictional contacts while the pair is within its bonding range (fix bond/breakable broken_contact)"),
 
       // --- breakage sweep (stage 2) ---
