@@ -1,0 +1,127 @@
+// The calibrate stage's fitting scheme on hand-made iterations (no engine):
+// the order of the UCS/tensile levers and the secant's memory across a lever
+// move (docs/calibration.md, "Fitting scheme").
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "stages/calibrate/fitting.h"
+
+using namespace mill;
+using namespace mill::calibrate;
+
+namespace {
+
+const Targets kCard{18.69e9, 0.18, 50e6, 5e6};  // sandstone
+
+// An iteration with parameters p that achieved E, nu, UCS and T.
+Iteration made(const BondParams& p, double E, double nu, double ucs, double t) {
+  Iteration it;
+  it.p = p;
+  it.ucs.r.youngs_modulus = E;
+  it.ucs.r.poisson_ratio = nu;
+  it.ucs.r.ucs = ucs;
+  it.br.r.tensile_strength = t;
+  return it;
+}
+
+BondParams start() {
+  BondParams p;
+  p.modulus = 68e9;
+  p.stiffness_ratio = 4.0;
+  p.tensile = 30e6;
+  p.cohesion = 60e6;
+  p.friction_angle_deg = 30.0;
+  p.moment_factor = 1.0;
+  return p;
+}
+
+}  // namespace
+
+// E and T met, UCS/T 4 against 10: the first lever is the moment factor
+// (to 0), nothing else of the strength levers moves.
+TEST(Fitting, FirstLeverIsTheMomentFactor) {
+  const Fitting fit(kCard, 0.1);
+  std::vector<Iteration> hist{made(start(), 18.69e9, 0.18, 20e6, 5e6)};
+  fit.score(hist.back());
+  std::vector<std::string> notes;
+  const BondParams p = fit.update(hist, notes);
+  EXPECT_EQ(p.moment_factor, 0.0);
+  EXPECT_EQ(p.friction_angle_deg, 30.0);
+  EXPECT_DOUBLE_EQ(p.cohesion / p.tensile, 2.0);  // cohesion ratio unchanged
+  ASSERT_FALSE(notes.empty());
+  EXPECT_NE(notes.back().find("moment factor"), std::string::npos) << notes.back();
+}
+
+// With beta already 0, the next lever is the friction angle, to its cap.
+TEST(Fitting, SecondLeverIsTheFrictionAngle) {
+  const Fitting fit(kCard, 0.1);
+  BondParams p0 = start();
+  p0.moment_factor = 0.0;
+  std::vector<Iteration> hist{made(p0, 18.69e9, 0.18, 24e6, 5e6)};
+  fit.score(hist.back());
+  std::vector<std::string> notes;
+  const BondParams p = fit.update(hist, notes);
+  EXPECT_EQ(p.moment_factor, 0.0);
+  EXPECT_EQ(p.friction_angle_deg, kMaxFrictionAngle);
+  EXPECT_DOUBLE_EQ(p.cohesion / p.tensile, 2.0);
+}
+
+// Both levers spent: the cohesion ratio rises (UCS/T below the card's).
+TEST(Fitting, ThenTheCohesionRatio) {
+  const Fitting fit(kCard, 0.1);
+  BondParams p0 = start();
+  p0.moment_factor = 0.0;
+  p0.friction_angle_deg = kMaxFrictionAngle;
+  std::vector<Iteration> hist{made(p0, 18.69e9, 0.18, 28e6, 5e6)};
+  fit.score(hist.back());
+  std::vector<std::string> notes;
+  const BondParams p = fit.update(hist, notes);
+  EXPECT_GT(p.cohesion / p.tensile, 2.0);
+  EXPECT_LE(p.cohesion / p.tensile, 4.0 + 1e-12);  // at most x2 per step
+}
+
+// A ratio above the card's never moves the moment factor or the friction
+// angle: only the cohesion, downwards.
+TEST(Fitting, TooStrongInCompressionMovesOnlyTheCohesion) {
+  const Fitting fit(kCard, 0.1);
+  std::vector<Iteration> hist{made(start(), 18.69e9, 0.18, 80e6, 5e6)};
+  fit.score(hist.back());
+  std::vector<std::string> notes;
+  const BondParams p = fit.update(hist, notes);
+  EXPECT_EQ(p.moment_factor, 1.0);
+  EXPECT_EQ(p.friction_angle_deg, 30.0);
+  EXPECT_LT(p.cohesion / p.tensile, 2.0);
+}
+
+// No lever moves while E or T is off (most sensitive first).
+TEST(Fitting, LeversWaitForEAndTensile) {
+  const Fitting fit(kCard, 0.1);
+  std::vector<Iteration> hist{made(start(), 12e9, 0.18, 20e6, 3e6)};
+  fit.score(hist.back());
+  std::vector<std::string> notes;
+  const BondParams p = fit.update(hist, notes);
+  EXPECT_EQ(p.moment_factor, 1.0);
+  EXPECT_EQ(p.friction_angle_deg, 30.0);
+  EXPECT_GT(p.modulus, 68e9);
+  EXPECT_GT(p.tensile, 30e6);
+}
+
+// After a lever move the tensile secant does not use the iteration before
+// it: the step is the first-slope step (slope 1: sigma_b x T_card / T).
+// Through the old point it would have used the slope between two different
+// materials. Tolerance: 1e-9 relative.
+TEST(Fitting, NoSecantAcrossALeverMove) {
+  const Fitting fit(kCard, 0.1);
+  BondParams before = start();
+  BondParams after = before;
+  after.moment_factor = 0.0;
+  after.tensile = 0.8 * before.tensile;  // moved too: a secant through both would be defined
+  std::vector<Iteration> hist{made(before, 18.69e9, 0.18, 20e6, 5e6),
+                              made(after, 18.69e9, 0.18, 55e6, 11e6)};
+  for (auto& it : hist) fit.score(it);
+  std::vector<std::string> notes;
+  const BondParams p = fit.update(hist, notes);
+  EXPECT_NEAR(p.tensile / (after.tensile * 5e6 / 11e6), 1.0, 1e-9);
+}
