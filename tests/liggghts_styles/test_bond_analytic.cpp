@@ -28,94 +28,11 @@
 #include <tuple>
 #include <vector>
 
-#include "deck_runner.h"
+#include "bond_test_util.h"
 
 using namespace mill_test;
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kR = 1e-3;        // element radius [m]
-constexpr double kRho = 2500.0;    // density [kg/m3]
-constexpr double kEb = 2e10;       // bond modulus [Pa]
-constexpr double kRatio = 2.5;     // kn/ks
-constexpr double kSigmaT = 2e7;    // tensile strength [Pa]
-constexpr double kCohesion = 2e7;  // cohesion [Pa]
-constexpr double kPhiDeg = 30.0;   // friction angle [deg]
-constexpr double kL0 = 2.1e-3;     // centre distance of a bonded pair [m]
-
-constexpr double kKn = kEb / kL0;                    // normal stiffness per area [Pa/m]
-constexpr double kKs = kKn / kRatio;                 // shear stiffness per area [Pa/m]
-constexpr double kArea = kPi * kR * kR;              // bond area [m2]
-constexpr double kInertia = 0.25 * kArea * kR * kR;  // bond I [m4]
-constexpr double kPolar = 2.0 * kInertia;            // bond J [m4]
-
-double sphere_mass(double r) { return kRho * 4.0 / 3.0 * kPi * r * r * r; }
-double sphere_inertia(double r) { return 0.4 * sphere_mass(r) * r * r; }
-
-// One sphere of the data file.
-struct Sphere {
-  std::array<double, 3> x{};  // position [m]
-  std::array<double, 3> v{};  // velocity [m/s]
-  std::array<double, 3> w{};  // angular velocity [rad/s]
-  double r = kR;              // radius [m]
-};
-
-// Deck head of deck_head() with the box read from data.txt instead of made by
-// region/create_box; split_x adds `processors * 1 1` (2 ranks split at x = 0).
-std::string head_data(double half_box, bool split_x = false) {
-  std::string head = deck_head(half_box);
-  const size_t a = head.find("region box block");
-  const std::string create = "create_box 1 box\n";
-  const size_t b = head.find(create);
-  head.replace(a, b + create.size() - a, "read_data data.txt\n");
-  if (split_x) {
-    const std::string comm_line = "communicate single vel yes\n";
-    head.insert(head.find(comm_line) + comm_line.size(), "processors * 1 1\n");
-  }
-  return head;
-}
-
-// LIGGGHTS data file (atom_style sphere) in a cubic box of half width half_box.
-std::string data_text(const std::vector<Sphere> &atoms, double half_box) {
-  std::ostringstream d;
-  d.precision(17);
-  d << "LIGGGHTS data file (test_bond_analytic)\n\n"
-    << atoms.size() << " atoms\n1 atom types\n\n"
-    << -half_box << " " << half_box << " xlo xhi\n"
-    << -half_box << " " << half_box << " ylo yhi\n"
-    << -half_box << " " << half_box << " zlo zhi\n\nAtoms\n\n";
-  for (size_t k = 0; k < atoms.size(); ++k)
-    d << k + 1 << " 1 " << 2.0 * atoms[k].r << " " << kRho << " " << atoms[k].x[0] << " "
-      << atoms[k].x[1] << " " << atoms[k].x[2] << "\n";
-  d << "\nVelocities\n\n";
-  for (size_t k = 0; k < atoms.size(); ++k)
-    d << k + 1 << " " << atoms[k].v[0] << " " << atoms[k].v[1] << " " << atoms[k].v[2] << " "
-      << atoms[k].w[0] << " " << atoms[k].w[1] << " " << atoms[k].w[2] << "\n";
-  return d.str();
-}
-
-// Writes data.txt and runs head_data() + body in dir.
-RunResult run_with_data(const std::string &dir, const std::vector<Sphere> &atoms,
-                        const std::string &body, double half_box = 0.01, int nprocs = 1,
-                        bool split_x = false) {
-  {
-    std::ofstream out(dir + "/data.txt");
-    out << data_text(atoms, half_box);
-  }
-  return run_deck(dir, head_data(half_box, split_x) + body, nprocs);
-}
-
-// Fix line with the test's coefficients plus extra keywords.
-std::string bond_fix(const std::string &extra = "", double sigma_t = kSigmaT,
-                     double cohesion = kCohesion) {
-  std::ostringstream s;
-  s.precision(17);
-  s << "fix bonds all bond/breakable radius_multiplier 1.0 modulus " << kEb << " stiffness_ratio "
-    << kRatio << " tensile_strength " << sigma_t << " cohesion " << cohesion << " friction_angle "
-    << kPhiDeg << " damping 0.0 gap 0.2 max_bonds 16 " << extra << "\n";
-  return s.str();
-}
 
 // `moment_factor beta` unless beta is the default 1 (then the default is used).
 std::string beta_keyword(double beta) {
@@ -123,16 +40,6 @@ std::string beta_keyword(double beta) {
   std::ostringstream s;
   s << "moment_factor " << beta;
   return s.str();
-}
-
-// Two spheres on the x axis at centre distance kL0 with spins wa, wb.
-std::vector<Sphere> spinning_pair(const std::array<double, 3> &wa,
-                                  const std::array<double, 3> &wb) {
-  Sphere a, b;
-  b.x = {kL0, 0.0, 0.0};
-  a.w = wa;
-  b.w = wb;
-  return {a, b};
 }
 
 // Kinetic energy, translational plus rotational (0.4 m r^2), of the data [J].
@@ -153,33 +60,9 @@ struct Lcg {
   }
 };
 
-// Times where column col crosses level upwards (linear interpolation; column 0 = time).
-std::vector<double> crossings_up(const std::vector<std::vector<double>> &rows, int col,
-                                 double level) {
-  std::vector<double> t;
-  for (size_t k = 1; k < rows.size(); ++k) {
-    const double y0 = rows[k - 1][col] - level, y1 = rows[k][col] - level;
-    if (y0 < 0.0 && y1 >= 0.0)
-      t.push_back(rows[k - 1][0] + (rows[k][0] - rows[k - 1][0]) * (-y0) / (y1 - y0));
-  }
-  return t;
-}
-
 // Mean period from upward crossings (needs >= 3).
 double mean_period(const std::vector<double> &up) {
   return (up.back() - up.front()) / static_cast<double>(up.size() - 1);
-}
-
-// Rows of a fix print table of the last run, keyed by step (column 0): a
-// step printed twice keeps its last row. (fix print does not print at the
-// setup of a run: the first row is step 1.)
-std::vector<std::vector<double>> last_run_rows(const std::string &path) {
-  std::vector<std::vector<double>> rows;
-  for (auto &row : read_table(path)) {
-    while (!rows.empty() && rows.back()[0] >= row[0]) rows.pop_back();
-    rows.push_back(row);
-  }
-  return rows;
 }
 
 // Eigenvalues of the symmetric matrix a (n x n, row major) by cyclic Jacobi
@@ -291,6 +174,21 @@ BreakRun read_break_run(const std::string &path) {
   return br;
 }
 
+// Deck body of the moment-break tests: the bond fix with moment_factor beta,
+// the kBreakPrint columns, `steps` steps of dt.
+std::string moment_break_deck(double beta, double dt, int steps) {
+  std::ostringstream d;
+  d.precision(17);
+  d << bond_fix(beta_keyword(beta)) << "timestep " << dt << "\n"
+    << kBreakPrint << "thermo 1000\nrun " << steps << "\n";
+  return d.str();
+}
+
+// Test name of a moment_factor parameter.
+std::string beta_name(const ::testing::TestParamInfo<double> &info) {
+  return info.param == 1.0 ? std::string("Beta1") : std::string("Beta05");
+}
+
 }  // namespace
 
 // ===========================================================================
@@ -309,11 +207,8 @@ TEST_P(BondBendingBreak, BreaksAtTensileStrengthOverBeta) {
   const double m_star = kSigmaT * kInertia / (beta * kR);
   const double rate = kKn * kInertia * 2.0 * w * dt;  // moment per step [N m]
   const int steps = static_cast<int>(1.5 * m_star / rate) + 100;
-  std::ostringstream d;
-  d.precision(17);
-  d << bond_fix(beta_keyword(beta)) << "timestep " << dt << "\n"
-    << kBreakPrint << "thermo 1000\nrun " << steps << "\n";
-  const auto r = run_with_data(dir, spinning_pair({0, 0, -w}, {0, 0, w}), d.str());
+  const auto r =
+      run_with_data(dir, spinning_pair({0, 0, -w}, {0, 0, w}), moment_break_deck(beta, dt, steps));
   ASSERT_EQ(r.exit_code, 0) << r.screen;
   const auto br = read_break_run(dir + "/hist.txt");
   ASSERT_TRUE(br.ok) << "bond did not break within " << steps << " steps";
@@ -331,10 +226,7 @@ TEST_P(BondBendingBreak, BreaksAtTensileStrengthOverBeta) {
   EXPECT_EQ(br.shear, 0.0);    // exact count
 }
 
-INSTANTIATE_TEST_SUITE_P(MomentFactor, BondBendingBreak, ::testing::Values(1.0, 0.5),
-                         [](const ::testing::TestParamInfo<double> &info) {
-                           return info.param == 1.0 ? std::string("Beta1") : std::string("Beta05");
-                         });
+INSTANTIATE_TEST_SUITE_P(MomentFactor, BondBendingBreak, ::testing::Values(1.0, 0.5), beta_name);
 
 // ===========================================================================
 // 2. Pure twisting breaks in shear at M_t = c J / (beta R).
@@ -350,11 +242,8 @@ TEST_P(BondTwistBreak, BreaksAtCohesionOverBeta) {
   const double m_star = kCohesion * kPolar / (beta * kR);
   const double rate = kKs * kPolar * 2.0 * w * dt;  // moment per step [N m]
   const int steps = static_cast<int>(1.5 * m_star / rate) + 100;
-  std::ostringstream d;
-  d.precision(17);
-  d << bond_fix(beta_keyword(beta)) << "timestep " << dt << "\n"
-    << kBreakPrint << "thermo 1000\nrun " << steps << "\n";
-  const auto r = run_with_data(dir, spinning_pair({-w, 0, 0}, {w, 0, 0}), d.str());
+  const auto r =
+      run_with_data(dir, spinning_pair({-w, 0, 0}, {w, 0, 0}), moment_break_deck(beta, dt, steps));
   ASSERT_EQ(r.exit_code, 0) << r.screen;
   const auto br = read_break_run(dir + "/hist.txt");
   ASSERT_TRUE(br.ok) << "bond did not break within " << steps << " steps";
@@ -371,10 +260,7 @@ TEST_P(BondTwistBreak, BreaksAtCohesionOverBeta) {
   EXPECT_EQ(br.tension, 0.0);                          // exact count
 }
 
-INSTANTIATE_TEST_SUITE_P(MomentFactor, BondTwistBreak, ::testing::Values(1.0, 0.5),
-                         [](const ::testing::TestParamInfo<double> &info) {
-                           return info.param == 1.0 ? std::string("Beta1") : std::string("Beta05");
-                         });
+INSTANTIATE_TEST_SUITE_P(MomentFactor, BondTwistBreak, ::testing::Values(1.0, 0.5), beta_name);
 
 // ===========================================================================
 // 3. A compressed bond needs more bending to break, by exactly F_n / A:

@@ -33,113 +33,13 @@
 #include <string>
 #include <vector>
 
-#include "deck_runner.h"
+#include "bond_test_util.h"
 
 using namespace mill_test;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kR = 1e-3;        // element radius [m]
-constexpr double kRho = 2500.0;    // density [kg/m3]
-constexpr double kEb = 2e10;       // bond modulus [Pa]
-constexpr double kRatio = 2.5;     // kn/ks
-constexpr double kSigmaT = 2e7;    // tensile strength [Pa]
-constexpr double kCohesion = 2e7;  // cohesion [Pa]
-constexpr double kPhiDeg = 30.0;   // friction angle [deg]
-constexpr double kGap = 0.2;       // bonding gap, x min radius
-constexpr double kL0 = 2.1e-3;     // centre distance of a bonded pair [m]
-
-constexpr double kKn = kEb / kL0;                    // normal stiffness per area [Pa/m]
-constexpr double kKs = kKn / kRatio;                 // shear stiffness per area [Pa/m]
-constexpr double kArea = kPi * kR * kR;              // bond area [m2]
-constexpr double kInertia = 0.25 * kArea * kR * kR;  // bond I [m4]
-constexpr double kPolar = 2.0 * kInertia;            // bond J [m4]
 const double kTanPhi = std::tan(kPhiDeg * kPi / 180.0);
-
-// One sphere of the data file.
-struct Sphere {
-  std::array<double, 3> x{};  // position [m]
-  std::array<double, 3> v{};  // velocity [m/s]
-  std::array<double, 3> w{};  // angular velocity [rad/s]
-  double r = kR;              // radius [m]
-};
-
-// deck_head() with the box read from data.txt instead of region/create_box;
-// split_x adds `processors * 1 1` (2 ranks split the box at x = 0).
-std::string head_data(double half_box, bool split_x = false) {
-  std::string head = deck_head(half_box);
-  const size_t a = head.find("region box block");
-  const std::string create = "create_box 1 box\n";
-  const size_t b = head.find(create);
-  head.replace(a, b + create.size() - a, "read_data data.txt\n");
-  if (split_x) {
-    const std::string comm_line = "communicate single vel yes\n";
-    head.insert(head.find(comm_line) + comm_line.size(), "processors * 1 1\n");
-  }
-  return head;
-}
-
-// LIGGGHTS data file (atom_style sphere) in a cubic box of half width half_box.
-std::string data_text(const std::vector<Sphere> &atoms, double half_box) {
-  std::ostringstream d;
-  d.precision(17);
-  d << "LIGGGHTS data file (test_bond_contacts)\n\n"
-    << atoms.size() << " atoms\n1 atom types\n\n"
-    << -half_box << " " << half_box << " xlo xhi\n"
-    << -half_box << " " << half_box << " ylo yhi\n"
-    << -half_box << " " << half_box << " zlo zhi\n\nAtoms\n\n";
-  for (size_t k = 0; k < atoms.size(); ++k)
-    d << k + 1 << " 1 " << 2.0 * atoms[k].r << " " << kRho << " " << atoms[k].x[0] << " "
-      << atoms[k].x[1] << " " << atoms[k].x[2] << "\n";
-  d << "\nVelocities\n\n";
-  for (size_t k = 0; k < atoms.size(); ++k)
-    d << k + 1 << " " << atoms[k].v[0] << " " << atoms[k].v[1] << " " << atoms[k].v[2] << " "
-      << atoms[k].w[0] << " " << atoms[k].w[1] << " " << atoms[k].w[2] << "\n";
-  return d.str();
-}
-
-// Writes data.txt and runs head_data() + body in dir.
-RunResult run_with_data(const std::string &dir, const std::vector<Sphere> &atoms,
-                        const std::string &body, double half_box = 0.01, int nprocs = 1,
-                        bool split_x = false) {
-  {
-    std::ofstream out(dir + "/data.txt");
-    out << data_text(atoms, half_box);
-  }
-  return run_deck(dir, head_data(half_box, split_x) + body, nprocs);
-}
-
-// Fix line with the test's coefficients plus extra keywords.
-std::string bond_fix(const std::string &extra) {
-  std::ostringstream s;
-  s.precision(17);
-  s << "fix bonds all bond/breakable radius_multiplier 1.0 modulus " << kEb << " stiffness_ratio "
-    << kRatio << " tensile_strength " << kSigmaT << " cohesion " << kCohesion << " friction_angle "
-    << kPhiDeg << " damping 0.0 gap " << kGap << " max_bonds 16 " << extra << "\n";
-  return s.str();
-}
-
-// Two spheres on the x axis at centre distance kL0 with spins wa, wb.
-std::vector<Sphere> pair_with_spins(const std::array<double, 3> &wa,
-                                    const std::array<double, 3> &wb) {
-  Sphere a, b;
-  b.x = {kL0, 0.0, 0.0};
-  a.w = wa;
-  b.w = wb;
-  return {a, b};
-}
-
-// Rows of a fix print table keyed by step (column 0): a step printed twice
-// keeps its last row. (fix print does not print at the setup of a run.)
-std::vector<std::vector<double>> step_rows(const std::string &path) {
-  std::vector<std::vector<double>> rows;
-  for (auto &row : read_table(path)) {
-    while (!rows.empty() && rows.back()[0] >= row[0]) rows.pop_back();
-    rows.push_back(row);
-  }
-  return rows;
-}
 
 // Whole text of a file ("" if missing).
 std::string slurp(const std::string &path) {
@@ -227,9 +127,9 @@ std::vector<std::vector<double>> run_compressed_shear(const std::string &dir,
     << "displace_atoms a2 move " << -kDelta << " 0 0 units box\n"
     << "fix mv a2 move linear 0 " << kShearV << " 0\n"
     << "run " << steps << "\n";
-  const auto r = run_with_data(dir, pair_with_spins({0, 0, 0}, {0, 0, 0}), d.str());
+  const auto r = run_with_data(dir, spinning_pair({0, 0, 0}, {0, 0, 0}), d.str());
   EXPECT_EQ(r.exit_code, 0) << r.screen;
-  return step_rows(dir + "/hist.txt");
+  return last_run_rows(dir + "/hist.txt");
 }
 
 // Steps of the shear run: through the break at (c + tan(phi) kn delta) A and
@@ -356,9 +256,9 @@ TEST(BondContact, NoTensionAndDroppedPastBondingGap) {
   set_x(kL0 - delta);
   set_x(kL0 + 1.05 * drop);  // (d)
   set_x(kL0 - delta);
-  const auto r = run_with_data(dir, pair_with_spins({0, 0, 0}, {0, 0, 0}), d.str());
+  const auto r = run_with_data(dir, spinning_pair({0, 0, 0}, {0, 0, 0}), d.str());
   ASSERT_EQ(r.exit_code, 0) << r.screen;
-  const auto rows = step_rows(dir + "/hist.txt");
+  const auto rows = last_run_rows(dir + "/hist.txt");
   ASSERT_EQ(rows.size(), static_cast<size_t>(2 + pull_steps + 4));
   EXPECT_EQ(rows[0][NT], 1.0);  // exact count: broken in tension at step 1
   EXPECT_EQ(rows[0][NB], 0.0);  // exact count
@@ -458,9 +358,9 @@ TEST_P(BondContactMoment, GrowsLinearlyThenSaturatesAtCap) {
     << kPairPrint << "thermo 1000\nrun 0\n"
     << "set atom 2 x " << kL0 + 1.5 * kSigmaT / kKn << "\nrun 1\n"
     << "set atom 2 x " << kL0 - delta << "\nrun " << steps << "\n";
-  const auto r = run_with_data(dir, pair_with_spins(wa, wb), d.str());
+  const auto r = run_with_data(dir, spinning_pair(wa, wb), d.str());
   ASSERT_EQ(r.exit_code, 0) << r.screen;
-  const auto rows = step_rows(dir + "/hist.txt");
+  const auto rows = last_run_rows(dir + "/hist.txt");
   ASSERT_EQ(rows.size(), static_cast<size_t>(1 + steps));
   EXPECT_EQ(rows[0][NT], 1.0);  // exact count: the bond broke in tension at step 1
   const int col = mc.axis == 0 ? TX : TZ;
@@ -609,7 +509,7 @@ TEST_P(BondContactErrors, MessageNamesKeyAndValue) {
   std::ostringstream d;
   d.precision(17);
   d << bond_fix(bad.keywords) << "timestep 1e-8\nrun 1\n";
-  const auto r = run_with_data(dir, pair_with_spins({0, 0, 0}, {0, 0, 0}), d.str());
+  const auto r = run_with_data(dir, spinning_pair({0, 0, 0}, {0, 0, 0}), d.str());
   EXPECT_NE(r.screen.find(bad.expected), std::string::npos)
       << "expected message: " << bad.expected << "\ngot:\n"
       << r.screen;

@@ -9,34 +9,14 @@
 #include <map>
 #include <sstream>
 
-#include "deck_runner.h"
+#include "bond_test_util.h"
 
 using namespace mill_test;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kR = 1e-3;        // element radius [m]
-constexpr double kRho = 2500.0;    // density [kg/m3]
-constexpr double kEb = 2e10;       // bond modulus [Pa]
-constexpr double kRatio = 2.5;     // kn/ks
-constexpr double kSigmaT = 2e7;    // tensile strength [Pa]
-constexpr double kCohesion = 2e7;  // cohesion [Pa]
-constexpr double kL0 = 2.1e-3;     // centre distance of a bonded pair [m]
-
-const double kMass = kRho * 4.0 / 3.0 * kPi * kR * kR * kR;
-const double kArea = kPi * kR * kR;
-const double kKnA = kEb / kL0 * kArea;  // axial stiffness of the bond [N/m]
-
-// Fix line with the test's standard coefficients plus extra keywords.
-std::string bond_fix(const std::string &extra = "", double sigma_t = kSigmaT,
-                     double cohesion = kCohesion) {
-  std::ostringstream s;
-  s << "fix bonds all bond/breakable radius_multiplier 1.0 modulus " << kEb << " stiffness_ratio "
-    << kRatio << " tensile_strength " << sigma_t << " cohesion " << cohesion
-    << " friction_angle 30 damping 0.0 gap 0.2 max_bonds 16 " << extra << "\n";
-  return s.str();
-}
+const double kMass = sphere_mass(kR);  // element mass [kg]
+const double kKnA = kKn * kArea;       // axial stiffness of the bond [N/m]
 
 // Two elements on the x axis, centre distance kL0, diameter 2 kR.
 std::string pair_atoms() {
@@ -47,18 +27,6 @@ std::string pair_atoms() {
     << "set group all diameter " << 2 * kR << " density " << kRho << "\n"
     << "group a1 id 1\ngroup a2 id 2\n";
   return s.str();
-}
-
-// Times where the series y(t) crosses its mean upwards (linear interpolation).
-std::vector<double> upward_crossings(const std::vector<std::vector<double>> &rows, int col,
-                                     double mean) {
-  std::vector<double> t;
-  for (size_t k = 1; k < rows.size(); ++k) {
-    const double y0 = rows[k - 1][col] - mean, y1 = rows[k][col] - mean;
-    if (y0 < 0.0 && y1 >= 0.0)
-      t.push_back(rows[k - 1][0] + (rows[k][0] - rows[k - 1][0]) * (-y0) / (y1 - y0));
-  }
-  return t;
 }
 
 // Last row of a fix print table.
@@ -89,7 +57,7 @@ TEST(BondPair, AxialOscillationPeriod) {
   ASSERT_EQ(r.exit_code, 0) << r.screen;
   const auto rows = read_table(dir + "/osc.txt");
   ASSERT_GT(rows.size(), 3000u);
-  const auto up = upward_crossings(rows, 1, kL0);
+  const auto up = crossings_up(rows, 1, kL0);
   ASSERT_GE(up.size(), 5u);
   const double measured = (up.back() - up.front()) / (up.size() - 1);
   RecordProperty("period_measured_s", std::to_string(measured));
@@ -299,14 +267,6 @@ std::string burst_setup() {
     << "variable vz atom 100*(z-0.0021)\n"
     << "velocity all set v_vx v_vy v_vz units box\n";
   return d.str();
-}
-
-// deck_head with `processors * 1 1`: a 2-rank run splits the box at x = 0.
-std::string head_split_x(double half_box) {
-  std::string head = deck_head(half_box);
-  const std::string comm_line = "communicate single vel yes\n";
-  head.insert(head.find(comm_line) + comm_line.size(), "processors * 1 1\n");
-  return head;
 }
 
 // Final positions (id -> xyz) from a `dump custom id x y z` file.
