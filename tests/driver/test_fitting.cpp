@@ -125,3 +125,16 @@ TEST(Fitting, NoSecantAcrossALeverMove) {
   const BondParams p = fit.update(hist, notes);
   EXPECT_NEAR(p.tensile / (after.tensile * 5e6 / 11e6), 1.0, 1e-9);
 }
+
+// A small gap (UCS/T 12 % below the card's) is closed with the cohesion, not
+// with a coarse lever that would change the material for ~20 %.
+TEST(Fitting, SmallGapUsesTheCohesion) {
+  const Fitting fit(kCard, 0.1);
+  std::vector<Iteration> hist{made(start(), 18.69e9, 0.18, 44.6e6, 5e6)};  // UCS/T 8.9
+  fit.score(hist.back());
+  std::vector<std::string> notes;
+  const BondParams p = fit.update(hist, notes);
+  EXPECT_EQ(p.moment_factor, 1.0);
+  EXPECT_EQ(p.friction_angle_deg, 30.0);
+  EXPECT_GT(p.cohesion / p.tensile, 2.0);
+}

@@ -68,19 +68,22 @@ BondParams Fitting::update(const std::vector<Iteration>& hist,
   // towards failure; Potyondy 2015), then the friction angle to
   // kMaxFrictionAngle (the Mohr-Coulomb strength rises with compression and
   // falls with tension), then damped secant steps on the cohesion ratio
-  // c / sigma_b (the tensile lever moves both strengths). A ratio already
-  // above the card's moves only the cohesion.
+  // c / sigma_b (the tensile lever moves both strengths). A ratio above the
+  // card's, or within kCoarseLeverGap below it, moves only the cohesion.
   const double ratio_now = now.p.cohesion / now.p.tensile;
   double ratio = ratio_now;
   const double want = t_.ucs / t_.tensile;
   const double have = now.ucs.r.ucs / now.br.r.tensile_strength;
   if (now.err_E <= tol_ && now.err_t <= tol_ && post::RelativeError(have, want) > tol_) {
-    if (have < want && p.moment_factor > 0.0) {
+    // The moment factor and friction-angle moves are coarse (each raised the
+    // ratio by ~20 %): used only for a gap larger than that, else the cohesion.
+    const bool far_below = have * kCoarseLeverGap < want;
+    if (far_below && p.moment_factor > 0.0) {
       p.moment_factor = 0.0;
       notes.push_back(fmt::format(
           "iteration {}: UCS/tensile {:.2f} (card {:.1f}): moment factor {:g} -> 0", hist.size(),
           have, want, now.p.moment_factor));
-    } else if (have < want && p.friction_angle_deg < kMaxFrictionAngle) {
+    } else if (far_below && p.friction_angle_deg < kMaxFrictionAngle) {
       p.friction_angle_deg = kMaxFrictionAngle;
       notes.push_back(fmt::format(
           "iteration {}: UCS/tensile {:.2f} (card {:.1f}): bond friction angle {:g} -> {:g} deg",

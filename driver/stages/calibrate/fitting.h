@@ -22,6 +22,9 @@ inline constexpr double kMaxCohesionRatio = 50.0;
 // 1.73; above it tau_c = c - sigma_n tan(phi) leaves little shear strength
 // under tension.
 inline constexpr double kMaxFrictionAngle = 60.0;
+// The coarse UCS/tensile levers (moment factor, friction angle) move only
+// while the card's ratio is more than this factor above the one reached.
+inline constexpr double kCoarseLeverGap = 1.2;
 
 // One iteration: the bond parameters tried, both tests, their errors.
 struct Iteration {
