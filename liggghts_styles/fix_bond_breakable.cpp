@@ -689,13 +689,16 @@ bool FixBondBreakable::evaluate_contact(const AtomArrays &at, const ListedBond &
   if (advance)
     for (int k = 0; k < 3; ++k) hist[FS + k] = fs[k];
 
-  double fb[3];
-  for (int k = 0; k < 3; ++k) fb[k] = -fn * n[k] + fs[k];
+  // Normal push on b along n, with the optional dashpot; never a pull (a
+  // pair separating fast must not stick through the dashpot).
+  double push = -fn;
   if (damping_ > 0.0) {
     const double ma = at.rmass[a], mbm = at.rmass[b];
-    const double cn = 2.0 * damping_ * std::sqrt(ma * mbm / (ma + mbm) * bond.kn * bond.area);
-    for (int k = 0; k < 3; ++k) fb[k] -= cn * vn * n[k];
+    push -= 2.0 * damping_ * std::sqrt(ma * mbm / (ma + mbm) * bond.kn * bond.area) * vn;
+    push = std::max(push, 0.0);
   }
+  double fb[3];
+  for (int k = 0; k < 3; ++k) fb[k] = push * n[k] + fs[k];
   for (int k = 0; k < 3; ++k) out.fa[k] = -fb[k];
   cross3(ra_vec, out.fa, out.ta);
   cross3(rb_vec, fb, out.tb);
@@ -705,8 +708,9 @@ bool FixBondBreakable::evaluate_contact(const AtomArrays &at, const ListedBond &
   // bending and twisting with the bond's stiffnesses (P&C 2004, eq. 6), up to
   // the moment at which its edge lifts off under the uniform pressure
   // F_n/A, |M_b| <= |F_n| I/(A R) = |F_n| R/4, and the friction torque of a
-  // uniformly pressed disc, |M_t| <= tan(phi) |F_n| 2R/3 (Johnson 1985,
-  // sec. 7.2); beyond them the interface rocks or spins at that moment.
+  // uniformly pressed flat disc (the uniform-pressure clutch),
+  // |M_t| <= tan(phi) |F_n| 2R/3; beyond them the interface rocks or spins at
+  // that moment.
   double mb[3] = {hist[MB], hist[MB + 1], hist[MB + 2]};
   double mt = hist[MT];
   if (advance) {

@@ -174,7 +174,7 @@ Schema make_ore_schema() {
       opt(positive(key("calibrated.bond_tensile_strength", T::Real, "Pa", "", "Bond tensile strength"))),
       opt(positive(key("calibrated.bond_cohesion", T::Real, "Pa", "", "Bond shear cohesion"))),
       opt(range(key("calibrated.bond_friction_angle", T::Real, "deg", "", "Bond Mohr-Coulomb friction angle"), 0, false, 90, true)),
-      opt(range(key("calibrated.bond_moment_factor", T::Real, "", "", "Share of the bond moments in the bond stresses (absent: 1)"), 0, true, 1, true)),
+      opt(range(key("calibrated.bond_moment_factor", T::Real, "", "", "Share of the bond moments in the bond stresses (absent: 1)"), 0, false, 1, false)),
       opt(key("calibrated.input_hash", T::String, "", "", "Hash of the macro properties these were fitted to")),
   };
   return s;

@@ -62,7 +62,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_ore_ucs.yaml", {"bad_ore_ucs_card.yaml:5:", "ucs", "tensile_strength"}},
         BadCase{"bad_ore_nu.yaml", {"bad_ore_nu_card.yaml:4:", "poisson_ratio", "0.5", "[0, 0.5)"}},
         BadCase{"bad_ore_negative_E.yaml", {"bad_ore_negative_E_card.yaml:3:", "youngs_modulus", "-10.0e9", "> 0 Pa"}},
-        BadCase{"bad_ore_missing_key.yaml", {"bad_ore_missing_key_card.yaml", "ucs", "required key is missing"}}),
+        BadCase{"bad_ore_missing_key.yaml", {"bad_ore_missing_key_card.yaml", "ucs", "required key is missing"}},
+        BadCase{"bad_ore_moment_factor.yaml", {"bad_ore_moment_factor_card.yaml:8:", "calibrated.bond_moment_factor", "1.5", "[0, 1]"}}),
     [](const auto& info) {
       std::string n = info.param.file;
       n = n.substr(0, n.find('.'));
@@ -90,6 +91,19 @@ TEST(CaseFile, BundledCasesAreValid) {
   EXPECT_EQ(ref.doc.integer("injection.n_lumps"), 360);
   EXPECT_DOUBLE_EQ(ref.doc.reals("breakage.velocities").front(), 4.0);
   EXPECT_DOUBLE_EQ(ref.doc.reals("breakage.velocities").back(), 169.0);
+}
+
+// A calibration pasted into the card keeps a moment factor of 0 (what the
+// UCS/tensile lever sets): the card must accept it, as calibrated.yaml does.
+TEST(OreCard, CalibratedMomentFactorZeroIsValid) {
+  const fs::path dir = fs::temp_directory_path() / "mill_card_beta0";
+  fs::create_directories(dir);
+  std::ofstream(dir / "card.yaml") << "name: r\ndensity: 2580\nyoungs_modulus: 18.69e9\n"
+                                      "poisson_ratio: 0.18\nucs: 50.0e6\ntensile_strength: 5.0e6\n"
+                                      "calibrated:\n  bond_moment_factor: 0\n";
+  const auto ore = mill::config::Document::load(dir / "card.yaml", mill::config::ore_schema());
+  EXPECT_EQ(ore.real("calibrated.bond_moment_factor"), 0.0);
+  fs::remove_all(dir);
 }
 
 TEST(CaseFile, GraniteCardIsValid) {
