@@ -159,11 +159,15 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
   in["deck_version"] = kDeckVersion;
   const bool from_card = card_is_calibrated(ctx.cfg);
   if (card_has_stale_calibration(ctx.cfg)) {
-    // The fit starts from the card's stale calibration: part of the inputs.
-    nlohmann::json start = nlohmann::json::object();
-    for (const char* k : kCalibratedKeys)
-      if (std::string(k) != "calibrated.input_hash") start[k] = ctx.cfg.ore.real(k);
-    in["start"] = start;
+    // The fit starts from the card's stale calibration (read as the fit
+    // reads it, optional moment factor included): part of the inputs.
+    const BondParams b = card_calibration(ctx.cfg.ore);
+    in["start"] = {{"calibrated.bond_modulus", b.modulus},
+                   {"calibrated.stiffness_ratio", b.stiffness_ratio},
+                   {"calibrated.bond_tensile_strength", b.tensile},
+                   {"calibrated.bond_cohesion", b.cohesion},
+                   {"calibrated.bond_friction_angle", b.friction_angle_deg},
+                   {"calibrated.bond_moment_factor", b.moment_factor}};
   }
   if (from_card) {
     in["from_card"] = true;
