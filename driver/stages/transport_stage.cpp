@@ -25,7 +25,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;
-constexpr int kDeckVersion = 3;
+constexpr int kDeckVersion = 4;  // 4: fluid/drag checks the field's rotor speed (omega)
 
 // One lump of the injection schedule.
 struct Lump {
