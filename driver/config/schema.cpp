@@ -87,6 +87,8 @@ Schema make_case_schema() {
              "tiny: a few thousand cells (tests); quick: tens of thousands; reference: ~600k with layers"),
       at_least(key("flow.max_iterations", T::Int, "", "600", "Iteration cap of the steady solver"), 1),
       positive(key("flow.residual_target", T::Real, "", "1e-4", "Initial-residual target for p and U (convergence)")),
+      key("flow.allow_unconverged", T::Bool, "", "false",
+          "Go on with a flow that missed flow.residual_target within flow.max_iterations (sample, transport and what follows run on it; the report says so at the top). false: the sample stage stops with an error naming the run"),
       choice("flow.domain", "half", {"half", "full"},
              "half: solve z >= 0 with a symmetry plane at z = 0 and mirror it (the mill is mirror-symmetric; the full-domain steady solve is carried away by an antisymmetric mode, see docs/flow.md); full: the whole housing"),
 

@@ -261,6 +261,8 @@ std::string case_parameters(const config::Document& doc, double rpm, const MeshP
                    g.axis_x, g.axis_height, rt);
   s += fmt::format("rotorRadius     {:.10g};\nrimRadius       {:.10g};\n", rr, rim);
   s += fmt::format("omega           {:.10g};  // rad/s = {:g} rpm\n", omega, rpm);
+  s += fmt::format("torqueCentre    {};  // on the axis, for the shaft torque\n",
+                   vec(g.axis_x, g.axis_height, 0.0));
   s += fmt::format("rimZ            {:.10g};\nrimStart        {};\n", rim_z,
                    vec(g.axis_x + rim, g.axis_height, rim_z));
   s += fmt::format("axisPoint1      {};\naxisPoint2      {};\n\n",
@@ -299,6 +301,9 @@ std::string case_parameters(const config::Document& doc, double rpm, const MeshP
       "rhoRef          {:.10g};\nnu              {:.10g};\nmu              {:.10g};\nTRef          "
       "  {:.10g};\n",
       rho, mu / rho, mu, doc.real("gas.temperature"));
+  // forces function object: rho from the field (rhoSimpleFoam) or rhoRef
+  // times the kinematic pressure (simpleFoam)
+  s += fmt::format("forcesRho       {};\n", comp ? "rho" : "rhoInf");
   if (comp) {
     s += "pDims           [1 -1 -2 0 0 0 0];  // Pa, absolute\n";
     s += fmt::format(
