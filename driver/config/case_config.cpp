@@ -427,6 +427,12 @@ void check_physics(const Document& d) {
     fail("sample.spacing", fmt::format("expected at most half the narrowest housing side ({:g} m of {:g} m), got {:g} m",
                                        side / 2, side, d.real("sample.spacing")));
 
+  // The outlet's absolute pressure must stay above vacuum.
+  if (d.real("gas.outlet_pressure_drop") >= d.real("gas.pressure"))
+    fail("gas.outlet_pressure_drop",
+         fmt::format("expected less than gas.pressure ({:g} Pa): the outlet would be at or below vacuum, got {:g} Pa",
+                     d.real("gas.pressure"), d.real("gas.outlet_pressure_drop")));
+
   // Breakage: a given time step must be well inside the simulated time.
   const double after = d.real("breakage.duration_after_contact"), bdt = d.real("breakage.timestep");
   if (bdt > after / 10)
