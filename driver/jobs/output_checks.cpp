@@ -20,6 +20,13 @@ std::string check_file(const fs::path& f) {
   return "";
 }
 
+std::string check_exists(const fs::path& f) {
+  std::error_code ec;
+  if (!fs::exists(f, ec)) return f.string() + ": missing";
+  if (!fs::is_regular_file(f, ec)) return f.string() + ": not a regular file";
+  return "";
+}
+
 namespace {
 std::string slurp(const fs::path& f) {
   std::ifstream in(f, std::ios::binary);

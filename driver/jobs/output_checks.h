@@ -11,6 +11,8 @@ namespace mill::jobs {
 
 // Exists and is a non-empty regular file.
 std::string check_file(const std::filesystem::path& f);
+// Exists as a regular file, empty or not (a marker such as case.foam).
+std::string check_exists(const std::filesystem::path& f);
 // A JSON object (or array when `array_ok`).
 std::string check_json(const std::filesystem::path& f, bool array_ok = false);
 // An HDF5 file that opens (a truncated one does not).

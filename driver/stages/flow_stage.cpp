@@ -603,7 +603,7 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
 // The declared outputs of one rotor speed: report, solved case, geometry.
 std::string FlowStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
   const fs::path out = flow::output_dir(ctx.run_dir, job.label);
-  std::vector<std::string> r = {jobs::check_json(out / "flow_report.json"), jobs::check_file(out / "case" / "case.foam")};
+  std::vector<std::string> r = {jobs::check_json(out / "flow_report.json"), jobs::check_exists(out / "case" / "case.foam")};
   for (const char* stl : {"housing.stl", "flywheel.stl", "inlet.stl", "outlet.stl"})
     r.push_back(jobs::check_file(out / "geometry" / stl));
   return jobs::first_problem(r);
