@@ -139,6 +139,13 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
 
   if (inv.dry_run)
     out << fmt::format("plan for case '{}' ({}), output {}\n", cfg.name, cfg.file.string(), run_dir.string());
+  // Every stage's plan as far as it is known now, before any stage runs: a
+  // label clash in a late stage must not surface after hours of earlier ones.
+  for (const auto& name : inv.stages) {
+    auto it = std::find_if(stages.begin(), stages.end(), [&](const auto& s) { return s->name() == name; });
+    StageContext ctx{cfg, inv.opts, run_dir, run_dir / name, runner, progress};
+    check_unique_labels(name, (*it)->plan(ctx));
+  }
 
   for (const auto& name : inv.stages) {
     auto it = std::find_if(stages.begin(), stages.end(), [&](const auto& s) { return s->name() == name; });
