@@ -125,8 +125,10 @@ Schema make_case_schema() {
       // --- breakage sweep (stage 2) ---
       choice("breakage.conditions", "sweep", {"sweep", "transport"},
              "sweep: the velocities/angles below; transport: binned from stage 1 impacts"),
-      positive(key("breakage.velocities", T::RealList, "m/s", "[4, 10, 20, 40, 60, 80, 100, 120, 150, 169]",
-                   "Impact speeds of the sweep")),
+      range(key("breakage.velocities", T::RealList, "m/s", "[4, 10, 20, 40, 60, 80, 100, 120, 150, 169]",
+                "Impact speeds of the sweep (beater mills reach 50-150 m/s; above 500 m/s a rock lump is a shock "
+                "problem the bond model does not describe)"),
+            0, true, 500, false),
       range(key("breakage.angles", T::RealList, "deg", "[90]", "Impact angles to the surface (90 = normal)"), 0, true, 90, false),
       at_least(key("breakage.repeats", T::Int, "", "1", "Repeats per condition (random orientation)"), 1),
       positive(key("breakage.duration_after_contact", T::Real, "s", "6e-3", "Simulated time after first contact, at most")),

@@ -6,11 +6,13 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
 #include "engine/runner.h"
 #include "jobs/job_store.h"
+#include "jobs/output_checks.h"
 #include "postprocess/breakage_results.h"
 #include "progress.h"
 
@@ -55,10 +57,18 @@ std::string esc(const std::string& s) {
   return o;
 }
 
+// A number for a table cell with the given precision ("{:.1f}"); a value
+// that is not a number (NaN, infinite: a damaged or degenerate result) reads
+// "n/a", never as a huge integer.
+std::string cell(double v, const char* spec, double scale = 1.0) {
+  if (!std::isfinite(v)) return "n/a";
+  return fmt::format(fmt::runtime(spec), scale * v);
+}
+
 std::string fmt_value(const nlohmann::json& v) {
-  if (v.is_number_float()) return fmt::format("{:.4g}", v.get<double>());
+  if (v.is_number_float()) return cell(v.get<double>(), "{:.4g}");
   if (v.is_string()) return esc(v.get<std::string>());
-  if (v.is_null()) return "-";
+  if (v.is_null()) return "n/a";
   return esc(v.dump());
 }
 
@@ -95,12 +105,19 @@ void json_table(std::ostringstream& o, const nlohmann::json& j, const std::strin
   if (prefix.empty()) o << "</table>\n";
 }
 
-// A JSON file, or null when it does not exist or does not parse.
-nlohmann::json read_json(const fs::path& f) {
+// Input files the report could not read, with the reason: shown at the top
+// of the report and printed as warnings, never silently left out.
+using Problems = std::vector<std::pair<fs::path, std::string>>;
+
+// A JSON file, or null when it does not exist; one that does not parse is
+// null too and goes into `problems`.
+nlohmann::json read_json(const fs::path& f, Problems& problems) {
   if (!fs::exists(f)) return nullptr;
   try {
     return nlohmann::json::parse(slurp(f));
-  } catch (const std::exception&) {
+  } catch (const std::exception& e) {
+    if (std::none_of(problems.begin(), problems.end(), [&](const auto& p) { return p.first == f; }))
+      problems.push_back({f, fmt::format("not valid JSON ({})", e.what())});
     return nullptr;
   }
 }
@@ -116,7 +133,7 @@ void embed_png(std::ostringstream& o, const fs::path& f, const std::string& capt
 }
 
 // The numbers an engineer looks at first, per stage (and per rotor speed).
-nlohmann::json headline(const fs::path& run) {
+nlohmann::json headline(const fs::path& run, Problems& problems) {
   nlohmann::json h = nlohmann::json::object();
   for (const auto& d : {run / "flow", run / "transport"}) {
     if (!fs::is_directory(d)) continue;
@@ -124,7 +141,7 @@ nlohmann::json headline(const fs::path& run) {
       const std::string rpm = e.path().filename().string();
       if (!e.is_directory() || rpm.rfind("rpm", 0) != 0) continue;
       if (d.filename() == "flow") {
-        const auto f = read_json(e.path() / "flow_report.json");
+        const auto f = read_json(e.path() / "flow_report.json", problems);
         if (f.is_null()) continue;
         h["flow"][rpm] = {{"domain", pick(f, "domain")},
                           {"cells", pick(f, "cells")},
@@ -134,7 +151,7 @@ nlohmann::json headline(const fs::path& run) {
                           {"inlet_mass_flow_kg_s", pick(pick(f, "mass_flow_kg_s"), "inlet_in")},
                           {"rim_gas_speed_to_tip_speed", pick(pick(f, "rim"), "ratio_speed_to_tip_speed")}};
       } else {
-        const auto t = read_json(e.path() / "summary.json");
+        const auto t = read_json(e.path() / "summary.json", problems);
         if (t.is_null()) continue;
         h["transport"][rpm] = {{"lumps", pick(t, "n_particles")},
                                {"flywheel_impacts", pick(t, "n_flywheel_impacts")},
@@ -145,11 +162,11 @@ nlohmann::json headline(const fs::path& run) {
       }
     }
   }
-  const auto cal = read_json(run / "calibrate" / "report.json");
+  const auto cal = read_json(run / "calibrate" / "report.json", problems);
   if (!cal.is_null())
     h["calibration"] = {{"source", pick(cal, "source")}, {"converged", pick(cal, "converged")},
                         {"achieved", pick(cal, "achieved")}};
-  const auto crit = read_json(run / "breakage" / "critical_velocity.json");
+  const auto crit = read_json(run / "breakage" / "critical_velocity.json", problems);
   if (crit.is_array()) {
     for (const auto& c : crit) {
       const auto angle = pick(c, "angle_deg");
@@ -159,7 +176,7 @@ nlohmann::json headline(const fs::path& run) {
     }
     h["breakage"]["critical_largest_fraction"] = crit.empty() ? nlohmann::json(nullptr) : pick(crit[0], "threshold");
   }
-  const auto prod = read_json(run / "breakage" / "product.json");
+  const auto prod = read_json(run / "breakage" / "product.json", problems);
   if (prod.is_array())
     for (const auto& p : prod)
       if (pick(p, "rpm").is_number()) h["product"][fmt::format("rpm{:g}", pick(p, "rpm").get<double>())] = {
@@ -187,10 +204,18 @@ Plan ReportStage::plan(const StageContext& ctx) const {
   return p;
 }
 
+// report/index.html (complete: it ends with </html>) and report/summary.json.
+std::string ReportStage::damaged_outputs(const StageContext& ctx, const JobSpec&) const {
+  return jobs::first_problem({jobs::check_text_ends(ctx.stage_dir / "index.html", "</html>"),
+                              jobs::check_json(ctx.stage_dir / "summary.json")});
+}
+
 void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
   const fs::path run = ctx.run_dir, out_dir = ctx.stage_dir;
   const auto inputs = report_inputs(run);
-  nlohmann::json summary = {{"case", ctx.cfg.name}, {"ore", ctx.cfg.ore.str("name")}, {"headline", headline(run)}};
+  Problems problems;
+  nlohmann::json summary = {{"case", ctx.cfg.name}, {"ore", ctx.cfg.ore.str("name")},
+                            {"headline", headline(run, problems)}};
 
   // Figures drawn for the report from the flow stage's files: the mill
   // geometry and the solver's convergence (matplotlib, Debian's python3).
@@ -212,7 +237,8 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
     << "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
        "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}"
        "td:first-child{text-align:left}img{max-width:100%;border:1px solid #eee;margin:0.5em 0}"
-       "h2{border-bottom:2px solid #468;padding-bottom:2px}.note{color:#666}</style></head><body>\n";
+       "h2{border-bottom:2px solid #468;padding-bottom:2px}.note{color:#666}"
+       ".bad{color:#a00;border:1px solid #a00;padding:0.5em}</style></head><body>\n";
   o << "<h1>Beater mill: case " << esc(ctx.cfg.name) << "</h1>\n";
   if (ctx.cfg.doc.has("description")) o << "<p>" << esc(ctx.cfg.doc.str("description")) << "</p>\n";
   o << "<p class=note>Case file <code>" << esc(ctx.cfg.file.string()) << "</code>, ore card <code>"
@@ -253,10 +279,10 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
       const std::string rel = fs::relative(f, out_dir).string();
       const std::string name = fs::relative(f, run).string();
       if (f.extension() == ".json") {
-        nlohmann::json j;
-        try {
-          j = nlohmann::json::parse(slurp(f));
-        } catch (const std::exception&) {
+        const nlohmann::json j = read_json(f, problems);
+        if (j.is_null()) {
+          o << "<h3>" << esc(name) << "</h3>\n<p class=bad>Not shown: this file is damaged (see the top of the "
+            << "page).</p>\n";
           continue;
         }
         o << "<h3>" << esc(name) << "</h3>\n";
@@ -271,21 +297,51 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
         o << "<p>Data: <a href=\"" << esc(rel) << "\">" << esc(name) << "</a></p>\n";
       }
     }
+    std::vector<post::ImpactSummary> rows;
     if (stage == "breakage" && fs::exists(run / "breakage" / "summary.csv")) {
-      const auto rows = post::ReadSummaryCsv((run / "breakage" / "summary.csv").string());
+      try {
+        rows = post::ReadSummaryCsv((run / "breakage" / "summary.csv").string());
+      } catch (const std::exception& e) {
+        problems.push_back({run / "breakage" / "summary.csv", e.what()});
+      }
+    }
+    if (!rows.empty()) {
       o << "<table><tr><th>V [m/s]</th><th>angle [deg]</th><th>repeat</th><th>pieces</th><th>single</th>"
            "<th>multi</th><th>largest [%]</th><th>single mass [%]</th><th>broken bonds [%]</th><th>E [kWh/t]</th>"
            "<th>t10 [%]</th></tr>\n";
       for (const auto& r : rows)
         o << fmt::format(
-            "<tr><td>{:g}</td><td>{:g}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.1f}</td>"
-            "<td>{:.1f}</td><td>{:.3g}</td><td>{:.1f}{}</td></tr>\n",
-            r.velocity_m_s, r.angle_deg, r.repeat, r.n_pieces, r.n_single, r.n_multi, 100 * r.largest_mass_fraction,
-            100 * r.single_mass_fraction, 100 * r.broken_bond_fraction, r.specific_energy_kWh_t, r.t10_percent,
-            r.t10_resolved ? "" : "*");
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>"
+            "<td>{}</td><td>{}</td><td>{}{}</td></tr>\n",
+            cell(r.velocity_m_s, "{:g}"), cell(r.angle_deg, "{:g}"), r.repeat, r.n_pieces, r.n_single, r.n_multi,
+            cell(r.largest_mass_fraction, "{:.1f}", 100), cell(r.single_mass_fraction, "{:.1f}", 100),
+            cell(r.broken_bond_fraction, "{:.1f}", 100), cell(r.specific_energy_kWh_t, "{:.3g}"),
+            cell(r.t10_percent, "{:.1f}"), r.t10_resolved ? "" : "*");
       o << "</table><p class=note>* t10 not resolved: single elements are coarser than a tenth of the lump.</p>\n";
       summary["breakage_impacts"] = rows.size();
     }
+  }
+  if (!problems.empty()) {
+    // Named at the top of the page, in summary.json and on the console.
+    std::ostringstream box;
+    box << "<div class=bad><b>Damaged input files, left out of this report:</b><ul>\n";
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& [f, why] : problems) {
+      const std::string rel = fs::relative(f, run).string();
+      box << "<li><code>" << esc(rel) << "</code>: " << esc(why) << "</li>\n";
+      list.push_back({{"file", rel}, {"problem", why}});
+      ctx.progress.warn(fmt::format("[report] {}: {}; left out of the report (rerun the stage that writes it, with "
+                                    "--force if its jobs are done)",
+                                    f.string(), why));
+    }
+    box << "</ul>Rerun the stage that writes each file (with <code>--force</code> if its jobs are done), then the "
+           "report.</div>\n";
+    summary["damaged_inputs"] = list;
+    std::string page = o.str();
+    const std::string anchor = "<h2>Headline numbers</h2>";
+    page.insert(page.find(anchor), box.str());
+    o.str(page);
+    o.seekp(0, std::ios::end);
   }
   o << "<hr><p class=note>Generated by orchestrate " << MILL_VERSION << ".</p></body></html>\n";
   jobs::atomic_write(out_dir / "index.html", o.str());
