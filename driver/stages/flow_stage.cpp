@@ -383,6 +383,31 @@ double read_flux(const fs::path& case_dir, const std::string& fo) {
   return v.size() >= 2 ? std::stod(v[1]) : NAN;
 }
 
+// Total moment (pressure + viscous) of the gas on the flywheel about the axis
+// point, last line of the forces function object's moment.dat: "time total_x
+// total_y total_z pressure_x ... viscous_z" (brackets, if any, are ignored).
+// Empty if missing.
+std::vector<double> read_moment(const fs::path& case_dir) {
+  fs::path f;
+  const fs::path root = case_dir / "postProcessing" / "flywheelForces";
+  if (fs::exists(root))
+    for (const auto& e : fs::recursive_directory_iterator(root))
+      if (e.path().filename() == "moment.dat") f = e.path();
+  if (f.empty()) return {};
+  std::ifstream in(f);
+  std::string l, last;
+  while (std::getline(in, l))
+    if (!l.empty() && l[0] != '#') last = l;
+  for (char& c : last)
+    if (c == '(' || c == ')') c = ' ';
+  std::istringstream ss(last);
+  std::vector<double> v;
+  double x;
+  while (ss >> x) v.push_back(x);
+  if (v.size() < 4) return {};
+  return {v[1], v[2], v[3]};
+}
+
 // Mean |U| and mean tangential U on the rim circle (sets function object).
 nlohmann::json read_rim(const fs::path& case_dir, const geometry::MillGeometry& g, double omega) {
   const auto f = flow::function_object_file(case_dir, "rimSpeed", ".xy");
@@ -550,6 +575,34 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
   rep["final_initial_residuals"] = s.initial_residual;
   rep["mass_flow_kg_s"] = {
       {"inlet_in", m_in}, {"outlet_out", m_out}, {"imbalance_relative", imbalance}};
+  // Backflow: phi summed with its sign (net) and as |phi| (sum of both
+  // directions) gives each direction: inflow through the outlet, outflow
+  // through the inlet (zero when the opening passes gas one way only).
+  const double in_mag = read_flux(work, "inletFlowMag"), out_mag = read_flux(work, "outletFlowMag");
+  const double in_back = 0.5 * (in_mag + in_flux) * to_mass * mirror;   // leaving via the inlet
+  const double out_back = 0.5 * (out_mag - out_flux) * to_mass * mirror;  // entering via the outlet
+  rep["backflow_kg_s"] = {{"inlet_out", in_back},
+                          {"outlet_in", out_back},
+                          {"inlet_abs_flux", in_mag * to_mass * mirror},
+                          {"outlet_abs_flux", out_mag * to_mass * mirror},
+                          {"note",
+                           "gas leaving through the inlet and entering through the outlet "
+                           "(sum of |phi| beside the net flux)"}};
+  // Shaft torque and power: the gas's moment on the flywheel about the axis
+  // (pressure + viscous, forces function object); the rotor turns at +omega
+  // about +z, so the motor supplies T = -M_z and P = T omega. For the half
+  // domain the mirrored half doubles M_z.
+  const auto moment = read_moment(work);
+  if (moment.size() == 3) {
+    const double torque = -moment[2] * mirror;
+    rep["shaft"] = {{"torque_Nm", torque},
+                    {"power_W", torque * omega},
+                    {"power_kW", torque * omega * 1e-3},
+                    {"note",
+                     "aerodynamic torque of the gas on the flywheel (pressure + viscous, about "
+                     "the axis) at the last iteration; the motor power the gas alone takes, "
+                     "without ore, bearings or windage outside the housing"}};
+  }
   const double a_in = read_patch_area(work, "inletFlow");
   const double a_out = read_patch_area(work, "outletFlow");
   rep["patch_area_m2"] = {{"inlet", a_in * mirror},
@@ -592,11 +645,17 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
   ctx.progress.info(
       fmt::format("{}: {} after {} iterations (p {:.2g}, U {:.2g}; target {:g}); {}mass flow in "
                   "{:.4g} kg/s, out {:.4g} kg/s, "
-                  "imbalance {:.2f}%; gas speed near rim {:.1f} m/s = {:.2f} x tip speed; mean y+ "
+                  "imbalance {:.2f}%; backflow in {:.3g} / out {:.3g} kg/s; shaft power {}; gas "
+                  "speed near rim {:.1f} m/s = {:.2f} x tip speed; mean y+ "
                   "flywheel {}, housing {}; "
                   "{} cells; {}",
                   tag, converged ? "converged" : "NOT converged", s.iterations, p_res, u_res,
                   target, half ? "half domain mirrored: " : "", m_in, m_out, 100 * imbalance,
+                  in_back, out_back,
+                  rep.contains("shaft")
+                      ? fmt::format("{:.3g} kW ({:.3g} N m)", rep["shaft"]["power_kW"].get<double>(),
+                                    rep["shaft"]["torque_Nm"].get<double>())
+                      : std::string("? (no moment.dat)"),
                   rim.value("gas_speed_mean_m_s", 0.0),
                   rim.value("ratio_speed_to_tip_speed", 0.0), ypl("flywheel"), ypl("housing"),
                   cells, Progress::duration(rep["wall_time_s"]["total"].get<double>())));

@@ -149,7 +149,11 @@ nlohmann::json headline(const fs::path& run, Problems& problems) {
                           {"converged", pick(f, "converged")},
                           {"mass_imbalance_relative", pick(pick(f, "mass_flow_kg_s"), "imbalance_relative")},
                           {"inlet_mass_flow_kg_s", pick(pick(f, "mass_flow_kg_s"), "inlet_in")},
-                          {"rim_gas_speed_to_tip_speed", pick(pick(f, "rim"), "ratio_speed_to_tip_speed")}};
+                          {"rim_gas_speed_to_tip_speed", pick(pick(f, "rim"), "ratio_speed_to_tip_speed")},
+                          {"shaft_torque_Nm", pick(pick(f, "shaft"), "torque_Nm")},
+                          {"shaft_power_kW", pick(pick(f, "shaft"), "power_kW")},
+                          {"backflow_outlet_in_kg_s", pick(pick(f, "backflow_kg_s"), "outlet_in")},
+                          {"backflow_inlet_out_kg_s", pick(pick(f, "backflow_kg_s"), "inlet_out")}};
       } else {
         const auto t = read_json(e.path() / "summary.json", problems);
         if (t.is_null()) continue;
@@ -243,6 +247,26 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
   if (ctx.cfg.doc.has("description")) o << "<p>" << esc(ctx.cfg.doc.str("description")) << "</p>\n";
   o << "<p class=note>Case file <code>" << esc(ctx.cfg.file.string()) << "</code>, ore card <code>"
     << esc(ctx.cfg.ore_file.string()) << "</code>. Every figure is embedded; its data file is linked.</p>\n";
+
+  // A flow that missed its residual target reaches here only with
+  // flow.allow_unconverged: say so first.
+  std::vector<std::string> unconverged;
+  const nlohmann::json& head = summary["headline"];
+  if (head.contains("flow") && head["flow"].is_object())
+    for (auto it = head["flow"].begin(); it != head["flow"].end(); ++it) {
+      if (it->is_object() && it->contains("converged") && it->at("converged").is_boolean() &&
+          !it->at("converged").get<bool>())
+        unconverged.push_back(it.key());
+    }
+  if (!unconverged.empty()) {
+    std::string list;
+    for (const auto& r : unconverged) list += (list.empty() ? "" : ", ") + r;
+    o << "<div class=bad><b>The gas flow did not converge</b> (" << esc(list)
+      << "): it missed <code>flow.residual_target</code> within <code>flow.max_iterations</code>, and "
+         "the case sets <code>flow.allow_unconverged: true</code>, so the sampled field, the lump "
+         "tracks, the impact conditions and the mill product below rest on an unconverged flow.</div>\n";
+    summary["unconverged_flow"] = unconverged;
+  }
 
   o << "<h2>Headline numbers</h2>\n";
   if (summary["headline"].empty()) o << "<p class=note>No stage has produced results yet.</p>\n";

@@ -376,6 +376,28 @@ void SampleStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path&
   const auto flow_rep = nlohmann::json::parse(rep_in, nullptr, false);
   const std::string domain =
       flow_rep.is_object() ? flow_rep.value("domain", std::string("full")) : "full";
+  const double job_rpm = job.inputs.at("rotor.rpm").get<double>();
+  if (flow_rep.is_object() && flow_rep.contains("rpm") && flow_rep["rpm"].is_number() &&
+      flow_rep["rpm"].get<double>() != job_rpm)
+    throw std::runtime_error(fmt::format(
+        "{}: the flow was solved at {:g} rpm, not the {:g} rpm of this job; rerun --stage flow",
+        (flow_out / "flow_report.json").string(), flow_rep["rpm"].get<double>(), job_rpm));
+  // An unconverged flow is not a prediction: stop here unless the case says
+  // to go on (the report then says so at the top).
+  if (flow_rep.is_object() && flow_rep.value("converged", true) == false &&
+      !doc.boolean("flow.allow_unconverged")) {
+    const auto res = flow_rep.value("final_initial_residuals", nlohmann::json::object());
+    std::string r;
+    for (const auto& [k, v] : res.items())
+      if (v.is_number()) r += fmt::format("{}{} {:.2g}", r.empty() ? "" : ", ", k, v.get<double>());
+    throw std::runtime_error(fmt::format(
+        "flow/{} did not converge: initial residuals {} after {} iterations, target {:g} "
+        "(flow.residual_target); its gas field is not a prediction. Raise flow.max_iterations, "
+        "choose another flow.mesh_preset, or set flow.allow_unconverged: true in {} to go on "
+        "with it (the report then says so at the top); solver log in {}",
+        job.label, r.empty() ? "?" : r, flow_rep.value("iterations", 0),
+        flow_rep.value("residual_target", 0.0), doc.file(), (flow_out / "case").string()));
+  }
   const bool mirrored = sample::half_domain_case(flow_out / "case");
   if (mirrored != (domain == "half"))
     throw std::runtime_error(fmt::format(
@@ -387,7 +409,7 @@ void SampleStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path&
 
   ctx.progress.job_step(job.label, "resample", -1);
   post::FlowField f = sample::resample_case(flow_out / "case", grid, opt);
-  f.rpm = job.inputs.at("rotor.rpm").get<double>();
+  f.rpm = job_rpm;
   f.gas_model = doc.str("gas.model");
   f.source = "flow/" + job.label + "/case, vtkOpenFOAMReader + vtkResampleToImage" +
              (mirrored ? ", half domain z >= 0 mirrored about z = 0 (Uz flipped)" : "");
@@ -418,6 +440,7 @@ void SampleStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path&
                         {"gas_fraction", static_cast<double>(gas) / f.size()},
                         {"max_speed_m_s", umax},
                         {"flow_domain", domain},
+                        {"flow_converged", flow_rep.is_object() ? flow_rep.value("converged", true) : true},
                         {"mirrored_about_z0", mirrored},
                         {"midplane_png",
                          {{"file", "midplane_speed.png"},

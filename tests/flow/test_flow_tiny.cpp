@@ -187,6 +187,48 @@ TEST(FlowTiny, IncompressibleMeshRunSample) {
   check_outputs(r.opts.output, true, 1.2, 1.2);
   check_half_domain(r.opts.output, 1.2);
   EXPECT_NE(r.out.str().find("mass flow"), std::string::npos) << r.out.str();
+  const auto rep = read_json(r.opts.output / "flow" / "rpm2000" / "flow_report.json");
+  // The gas resists the turning rotor: the shaft supplies a positive torque,
+  // and the power is torque x omega.
+  const double torque = rep["shaft"]["torque_Nm"].get<double>();
+  EXPECT_GT(torque, 0.0);
+  EXPECT_NEAR(rep["shaft"]["power_W"].get<double>(), torque * rep["omega_rad_s"].get<double>(),
+              1e-12 * std::abs(torque) * rep["omega_rad_s"].get<double>());
+  EXPECT_NE(r.out.str().find("shaft power"), std::string::npos) << r.out.str();
+  // Backflow of each opening: between 0 and the sum of |phi| through it.
+  for (const auto& [k, abs_key] : {std::pair{"inlet_out", "inlet_abs_flux"}, {"outlet_in", "outlet_abs_flux"}}) {
+    const double b = rep["backflow_kg_s"][k].get<double>(), a = rep["backflow_kg_s"][abs_key].get<double>();
+    EXPECT_GE(b, -1e-12 * a) << k;
+    EXPECT_LE(b, a * (1 + 1e-12)) << k;
+  }
+  // 30 iterations do not converge: without flow.allow_unconverged the sample
+  // stage stops, naming the key, the residuals and the run.
+  EXPECT_EQ(rep["converged"], false);
+  {
+    const fs::path strict =
+        fs::temp_directory_path() / ("mill_flow_strict_" + std::to_string(getpid()) + ".yaml");
+    std::ifstream in(kData / "tiny.yaml");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    std::string t = ss.str();
+    t.replace(t.find("allow_unconverged: true"), 23, "allow_unconverged: false");
+    t.replace(t.find("name: flow_tiny"), 15, "name: flow_tiny_strict");  // StageRun clears its own folder
+    std::ofstream(strict) << t;
+    StageRun r2(strict, 1);
+    r2.opts.output = r.opts.output;
+    auto c = r2.ctx("sample");
+    const auto plan = sample.plan(c);
+    try {
+      sample.run_job(c, plan.jobs[0], c.stage_dir / "jobs" / "rpm2000");
+      FAIL() << "expected the unconverged flow to stop the sample stage";
+    } catch (const std::runtime_error& e) {
+      const std::string m = e.what();
+      for (const char* want : {"flow/rpm2000 did not converge", "flow.allow_unconverged: true",
+                               "after 30 iterations", "flow.residual_target"})
+        EXPECT_NE(m.find(want), std::string::npos) << want << " not in: " << m;
+    }
+    fs::remove(strict);
+  }
   // Sampling is repeatable: the same case resampled gives bit-identical fields
   // (a threaded probe picked cells on shared faces by thread timing, up to
   // 0.4 m/s apart on this mesh, before the sampler was made sequential).
