@@ -108,6 +108,16 @@ long read_long(const fs::path& f) {
 
 }  // namespace
 
+std::vector<std::string> BreakageStage::reads(const config::CaseConfig& cfg) const {
+  if (cfg.doc.str("breakage.conditions") == "transport") return {"transport", "calibrate"};
+  return {"calibrate"};
+}
+
+std::vector<std::string> BreakageStage::jobs_from(const config::CaseConfig& cfg) const {
+  if (cfg.doc.str("breakage.conditions") == "transport") return {"transport"};
+  return {};
+}
+
 Plan BreakageStage::plan(const StageContext& ctx) const {
   Plan p;
   const auto& d = ctx.cfg.doc;
