@@ -41,7 +41,8 @@ std::string in_dq(const std::string& s) {
 // A value in a message: quoted, control characters as \xNN (one line).
 std::string shown(const std::string& v) {
   std::string o = "'";
-  for (unsigned char c : v) o += std::iscntrl(c) ? fmt::format("\\x{:02x}", c) : std::string(1, static_cast<char>(c));
+  for (unsigned char c : v)
+    o += std::iscntrl(c) ? fmt::format("\\x{:02x}", c) : std::string(1, static_cast<char>(c));
   return o + "'";
 }
 
@@ -49,17 +50,17 @@ std::string shown(const std::string& v) {
 struct StageJob {
   std::string stage;
   bool array = false;
-  int tasks = 0;                    // array size known now; -1: counted by the planning job
-  std::string planned_from;         // tasks < 0: the stage of the range whose output decides the count
-  std::vector<std::string> after;   // stages of the range whose outputs it reads
+  int tasks = 0;             // array size known now; -1: counted by the planning job
+  std::string planned_from;  // tasks < 0: the stage of the range whose output decides the count
+  std::vector<std::string> after;  // stages of the range whose outputs it reads
   StageResources res;
 };
 
 // The one template: the #SBATCH header of every script.
 // log_pattern: Slurm's file-name pattern, %x_%A_%a (array) or %x_%j (single job).
-std::string header(const HpcOptions& o, const std::string& name, int ntasks, const std::string& time,
-                   const std::string& time_from, const StageResources& r, bool with_mem, const fs::path& logs,
-                   const char* log_pattern) {
+std::string header(const HpcOptions& o, const std::string& name, int ntasks,
+                   const std::string& time, const std::string& time_from, const StageResources& r,
+                   bool with_mem, const fs::path& logs, const char* log_pattern) {
   std::string h = "#!/bin/bash\n";
   h += sbatch_directive("--job-name", name, "name (the case name)");
   h += sbatch_directive("--ntasks", std::to_string(ntasks), "ranks");
@@ -67,28 +68,35 @@ std::string header(const HpcOptions& o, const std::string& name, int ntasks, con
   if (!r.partition.empty()) h += sbatch_directive("--partition", r.partition, r.partition_from);
   if (!o.account.empty()) h += sbatch_directive("--account", o.account, "--account");
   if (with_mem && !r.mem.empty()) h += sbatch_directive("--mem", r.mem, r.mem_from);
-  h += sbatch_directive("--output", fmt::format("{}/{}.out", logs.string(), log_pattern), "--output (the run folder)");
+  h += sbatch_directive("--output", fmt::format("{}/{}.out", logs.string(), log_pattern),
+                        "--output (the run folder)");
   return h;
 }
 
-std::string throttle(const HpcOptions& o) { return o.max_parallel > 0 ? fmt::format("%{}", o.max_parallel) : ""; }
+std::string throttle(const HpcOptions& o) {
+  return o.max_parallel > 0 ? fmt::format("%{}", o.max_parallel) : "";
+}
 
 }  // namespace
 
-std::string sbatch_directive(const std::string& option, const std::string& value, const std::string& source) {
+std::string sbatch_directive(const std::string& option, const std::string& value,
+                             const std::string& source) {
   if (value.empty())
-    throw config::ConfigError(fmt::format("{}: expected a value for #SBATCH {}, got nothing", source, option));
+    throw config::ConfigError(
+        fmt::format("{}: expected a value for #SBATCH {}, got nothing", source, option));
   for (char c : value)
     if (std::iscntrl(static_cast<unsigned char>(c)) || c == '"' || c == '\\')
-      throw config::ConfigError(fmt::format("{}: expected a value for #SBATCH {} on one line without control "
-                                            "characters, '\"' or '\\', got {}",
-                                            source, option, shown(value)));
+      throw config::ConfigError(
+          fmt::format("{}: expected a value for #SBATCH {} on one line without control "
+                      "characters, '\"' or '\\', got {}",
+                      source, option, shown(value)));
   // sbatch splits a directive at blanks and ends it at '#' outside double quotes.
   const bool plain = value.find_first_of(" #") == std::string::npos;
   return fmt::format("#SBATCH {}={}\n", option, plain ? value : "\"" + value + "\"");
 }
 
-StageResources stage_resources(const config::CaseConfig& cfg, const HpcOptions& o, const std::string& stage) {
+StageResources stage_resources(const config::CaseConfig& cfg, const HpcOptions& o,
+                               const std::string& stage) {
   const auto& d = cfg.doc;
   const std::string p = "resources." + stage + ".";
   StageResources r;
@@ -101,8 +109,8 @@ StageResources stage_resources(const config::CaseConfig& cfg, const HpcOptions& 
       r.np = static_cast<int>(d.integer("resources.np"));
   }
   // An option given on the command line, else the case's key (or none).
-  auto pick = [&](const std::string& opt_value, const char* opt_name, const std::string& key, std::string& value,
-                  std::string& from) {
+  auto pick = [&](const std::string& opt_value, const char* opt_name, const std::string& key,
+                  std::string& value, std::string& from) {
     if (!opt_value.empty()) {
       value = opt_value, from = opt_name;
     } else if (d.has(key)) {
@@ -117,17 +125,19 @@ StageResources stage_resources(const config::CaseConfig& cfg, const HpcOptions& 
 }
 
 std::string write_hpc_scripts(const config::CaseConfig& cfg, const HpcOptions& o,
-                              const std::function<int(const std::string&)>& n_tasks, const std::string& exe) {
+                              const std::function<int(const std::string&)>& n_tasks,
+                              const std::string& exe) {
   if (o.scheduler != "slurm")
-    throw config::ConfigError(fmt::format("--scheduler: expected 'slurm' (the only scheduler supported), got '{}'",
-                                          o.scheduler));
+    throw config::ConfigError(fmt::format(
+        "--scheduler: expected 'slurm' (the only scheduler supported), got '{}'", o.scheduler));
   if (o.stages.empty()) throw config::ConfigError("--stage: hpc needs the stages to script");
   const fs::path out = fs::absolute(o.output), dir = out / "hpc", logs = dir / "logs";
   // '%' starts a Slurm file-name pattern in #SBATCH --output.
   if (out.string().find('%') != std::string::npos)
-    throw config::ConfigError(fmt::format("--output: expected a run folder without '%' (Slurm reads it as a "
-                                          "file-name pattern in #SBATCH --output), got {}",
-                                          shown(out.string())));
+    throw config::ConfigError(
+        fmt::format("--output: expected a run folder without '%' (Slurm reads it as a "
+                    "file-name pattern in #SBATCH --output), got {}",
+                    shown(out.string())));
 
   // What each stage submits: its kind, size and the stages it waits for.
   const auto stage_list = make_stages();
@@ -136,7 +146,8 @@ std::string write_hpc_scripts(const config::CaseConfig& cfg, const HpcOptions& o
   };
   std::vector<StageJob> chain;
   for (const auto& name : o.stages) {
-    const auto it = std::find_if(stage_list.begin(), stage_list.end(), [&](const auto& s) { return s->name() == name; });
+    const auto it = std::find_if(stage_list.begin(), stage_list.end(),
+                                 [&](const auto& s) { return s->name() == name; });
     const Stage& st = **it;
     StageJob j;
     j.stage = name;
@@ -152,90 +163,118 @@ std::string write_hpc_scripts(const config::CaseConfig& cfg, const HpcOptions& o
       } else if ((j.tasks = n_tasks(name)) <= 0) {
         const auto from = st.jobs_from(cfg);
         throw config::ConfigError(fmt::format(
-            "--stage {}: stage '{}' has no jobs yet (its jobs come from an earlier stage that has not run){}", o.stage,
-            name, from.empty() ? "" : fmt::format("; script both: --stage {}-{}", from.front(), name)));
+            "--stage {}: stage '{}' has no jobs yet (its jobs come from an earlier stage that has "
+            "not run){}",
+            o.stage, name,
+            from.empty() ? "" : fmt::format("; script both: --stage {}-{}", from.front(), name)));
       }
     }
     chain.push_back(j);
   }
 
-  const std::string common = fmt::format("{} --case {} --output {}", quote(exe), quote(cfg.file.string()),
-                                         quote(out.string()));
+  const std::string common = fmt::format("{} --case {} --output {}", quote(exe),
+                                         quote(cfg.file.string()), quote(out.string()));
   const std::string submit_name = fmt::format("submit_{}.sh", o.stage);
   const fs::path submit_path = dir / submit_name;
   // Every script is made (and every value checked) before any is written.
   std::vector<std::pair<fs::path, std::string>> scripts;
-  auto write = [&](const std::string& file, const std::string& text) { scripts.emplace_back(dir / file, text); };
-  const std::string resubmit = fmt::format("echo \"Fix the cause, then submit again: sh {}  (done jobs are skipped)\" >&2\n",
-                                           in_dq(quote(submit_path.string())));
+  auto write = [&](const std::string& file, const std::string& text) {
+    scripts.emplace_back(dir / file, text);
+  };
+  const std::string resubmit =
+      fmt::format("echo \"Fix the cause, then submit again: sh {}  (done jobs are skipped)\" >&2\n",
+                  in_dq(quote(submit_path.string())));
 
   for (const auto& j : chain) {
     const std::string name = fmt::format("mill-{}-{}", cfg.name, j.stage);
     const std::string run = fmt::format("{} --stage {}", common, j.stage);
     if (!j.array) {
       // A small stage: one job runs it whole (its done jobs are skipped) and merges it.
-      std::string s = header(o, name, j.res.np, j.res.time, j.res.time_from, j.res, true, logs, "%x_%j");
-      s += fmt::format("# Stage {} of case '{}': every job of `orchestrate --stage {}` in this one Slurm job,\n"
-                       "# then its merge. Jobs done with the same inputs are skipped: resubmitting is safe.\n",
-                       j.stage, cfg.name, j.stage);
+      std::string s =
+          header(o, name, j.res.np, j.res.time, j.res.time_from, j.res, true, logs, "%x_%j");
+      s += fmt::format(
+          "# Stage {} of case '{}': every job of `orchestrate --stage {}` in this one Slurm job,\n"
+          "# then its merge. Jobs done with the same inputs are skipped: resubmitting is safe.\n",
+          j.stage, cfg.name, j.stage);
       s += "set -uo pipefail\n";
       s += "export MILL_SCHEDULER_JOB=\"$SLURM_JOB_ID\"\n";
-      s += fmt::format("export MILL_SCHEDULER_LOG={}/\"{}_$SLURM_JOB_ID.out\"\n", quote(logs.string()), name);
+      s += fmt::format("export MILL_SCHEDULER_LOG={}/\"{}_$SLURM_JOB_ID.out\"\n",
+                       quote(logs.string()), name);
       s += fmt::format("if {} --np {} --jobs 1; then exit 0; fi\n", run, j.res.np);
-      s += fmt::format("echo \"error: stage {} failed in Slurm job $SLURM_JOB_ID (log: $MILL_SCHEDULER_LOG); the "
-                       "chain stops here.\" >&2\n",
-                       j.stage);
+      s += fmt::format(
+          "echo \"error: stage {} failed in Slurm job $SLURM_JOB_ID (log: $MILL_SCHEDULER_LOG); "
+          "the "
+          "chain stops here.\" >&2\n",
+          j.stage);
       s += resubmit + "exit 1\n";
       write(j.stage + ".sh", s);
       continue;
     }
-    std::string a = header(o, name, j.res.np, j.res.time, j.res.time_from, j.res, true, logs, "%x_%A_%a");
+    std::string a =
+        header(o, name, j.res.np, j.res.time, j.res.time_from, j.res, true, logs, "%x_%A_%a");
     if (j.tasks > 0) a += fmt::format("#SBATCH --array=0-{}{}\n", j.tasks - 1, throttle(o));
-    a += fmt::format("# Stage {} of case '{}': array task I runs job I of `orchestrate --stage {} --list-tasks`\n"
-                     "# on --ntasks MPI ranks. A task whose job is done with the same inputs returns at once:\n"
-                     "# resubmitting is safe.\n",
-                     j.stage, cfg.name, j.stage);
+    a += fmt::format(
+        "# Stage {} of case '{}': array task I runs job I of `orchestrate --stage {} "
+        "--list-tasks`\n"
+        "# on --ntasks MPI ranks. A task whose job is done with the same inputs returns at once:\n"
+        "# resubmitting is safe.\n",
+        j.stage, cfg.name, j.stage);
     if (j.tasks < 0)
-      a += fmt::format("# The task count comes from the stage's plan once {} has run: {}.plan.sh passes --array.\n",
-                       j.planned_from, j.stage);
+      a += fmt::format(
+          "# The task count comes from the stage's plan once {} has run: {}.plan.sh passes "
+          "--array.\n",
+          j.planned_from, j.stage);
     a += "set -euo pipefail\n";
     a += "export MILL_SCHEDULER_JOB=\"${SLURM_ARRAY_JOB_ID}_${SLURM_ARRAY_TASK_ID}\"\n";
-    a += fmt::format("export MILL_SCHEDULER_LOG={}/\"{}_${{SLURM_ARRAY_JOB_ID}}_${{SLURM_ARRAY_TASK_ID}}.out\"\n",
-                     quote(logs.string()), name);
+    a += fmt::format(
+        "export "
+        "MILL_SCHEDULER_LOG={}/\"{}_${{SLURM_ARRAY_JOB_ID}}_${{SLURM_ARRAY_TASK_ID}}.out\"\n",
+        quote(logs.string()), name);
     a += fmt::format("exec {} --task \"$SLURM_ARRAY_TASK_ID\" --np {} --jobs 1\n", run, j.res.np);
     write(j.stage + ".array.sh", a);
 
-    std::string m = header(o, name + "-merge", 1, j.res.merge_time, j.res.merge_time_from, j.res, false, logs, "%x_%j");
-    m += fmt::format("# After the {} array (its job id is $1) ended, whatever the outcome: merge the stage when\n"
-                     "# every task succeeded; else name each failed task with its Slurm job and log, and fail,\n"
-                     "# which stops the chain (the next stages wait with afterok).\n",
-                     j.stage);
+    std::string m = header(o, name + "-merge", 1, j.res.merge_time, j.res.merge_time_from, j.res,
+                           false, logs, "%x_%j");
+    m += fmt::format(
+        "# After the {} array (its job id is $1) ended, whatever the outcome: merge the stage "
+        "when\n"
+        "# every task succeeded; else name each failed task with its Slurm job and log, and fail,\n"
+        "# which stops the chain (the next stages wait with afterok).\n",
+        j.stage);
     m += "set -uo pipefail\n";
     m += fmt::format("if {} --merge-only --np 1 --jobs 1; then exit 0; fi\n", run);
-    m += fmt::format("echo \"error: stage {} did not complete (array job ${{1:-?}}; logs in {}); the chain stops "
-                     "here.\" >&2\n",
-                     j.stage, in_dq(logs.string()));
+    m += fmt::format(
+        "echo \"error: stage {} did not complete (array job ${{1:-?}}; logs in {}); the chain "
+        "stops "
+        "here.\" >&2\n",
+        j.stage, in_dq(logs.string()));
     m += resubmit + "exit 1\n";
     write(j.stage + ".merge.sh", m);
 
     if (j.tasks < 0) {
-      std::string p = header(o, name + "-plan", 1, j.res.merge_time, j.res.merge_time_from, j.res, false, logs, "%x_%j");
-      p += fmt::format("# After {}: count the jobs of stage {} (they come from the outputs\n"
-                       "# of {}) and submit the {} array of that size and the stages after it.\n",
-                       fmt::join(j.after, " and "), j.stage, j.planned_from, j.stage);
+      std::string p = header(o, name + "-plan", 1, j.res.merge_time, j.res.merge_time_from, j.res,
+                             false, logs, "%x_%j");
+      p += fmt::format(
+          "# After {}: count the jobs of stage {} (they come from the outputs\n"
+          "# of {}) and submit the {} array of that size and the stages after it.\n",
+          fmt::join(j.after, " and "), j.stage, j.planned_from, j.stage);
       p += "set -euo pipefail\n";
       p += fmt::format("list=$({} --list-tasks)\n", run);
       p += "printf '%s\\n' \"$list\"\n";
       p += "n=$(printf '%s\\n' \"$list\" | grep -c '^[0-9]' || true)\n";
-      p += fmt::format("if [ \"$n\" -eq 0 ]; then\n"
-                       "  echo \"error: stage {} has no jobs (see the note above); the chain stops here.\" >&2\n"
-                       "  exit 1\n"
-                       "fi\n",
+      p += fmt::format(
+          "if [ \"$n\" -eq 0 ]; then\n"
+          "  echo \"error: stage {} has no jobs (see the note above); the chain stops here.\" >&2\n"
+          "  exit 1\n"
+          "fi\n",
+          j.stage);
+      p += fmt::format(
+          "echo \"stage {}: $n jobs, planned from the outputs of {}: submitting an array of $n "
+          "tasks "
+          "and the stages after it\"\n",
+          j.stage, j.planned_from);
+      p += fmt::format("exec sh {} --from {} --tasks \"$n\"\n", quote(submit_path.string()),
                        j.stage);
-      p += fmt::format("echo \"stage {}: $n jobs, planned from the outputs of {}: submitting an array of $n tasks "
-                       "and the stages after it\"\n",
-                       j.stage, j.planned_from);
-      p += fmt::format("exec sh {} --from {} --tasks \"$n\"\n", quote(submit_path.string()), j.stage);
       write(j.stage + ".plan.sh", p);
     }
   }
@@ -248,13 +287,15 @@ std::string write_hpc_scripts(const config::CaseConfig& cfg, const HpcOptions& o
     if (j.tasks < 0) planned.push_back(j.stage);
   }
   std::string s = "#!/bin/sh\n";
-  s += fmt::format("# Submits to Slurm the stage{} of case '{}': {},\n"
-                   "# chained with --dependency=afterok (written by `orchestrate hpc --stage {}`;\n"
-                   "# docs/hpc.md). Submitting it again resumes: jobs that are done are skipped.\n"
-                   "#   sh {}                            the whole chain\n"
-                   "#   sh {} --from STAGE [--tasks N]   from STAGE on (a planning job passes N,\n"
-                   "#                                      the size of the array it planned)\n",
-                   names.size() == 1 ? "" : "s", cfg.name, fmt::join(names, ", "), o.stage, submit_name, submit_name);
+  s += fmt::format(
+      "# Submits to Slurm the stage{} of case '{}': {},\n"
+      "# chained with --dependency=afterok (written by `orchestrate hpc --stage {}`;\n"
+      "# docs/hpc.md). Submitting it again resumes: jobs that are done are skipped.\n"
+      "#   sh {}                            the whole chain\n"
+      "#   sh {} --from STAGE [--tasks N]   from STAGE on (a planning job passes N,\n"
+      "#                                      the size of the array it planned)\n",
+      names.size() == 1 ? "" : "s", cfg.name, fmt::join(names, ", "), o.stage, submit_name,
+      submit_name);
   s += "set -eu\n";
   s += fmt::format("hpc={}\n", quote(dir.string()));
   s += fmt::format("from={}\ntasks=\n", names.front());
@@ -265,23 +306,32 @@ std::string write_hpc_scripts(const config::CaseConfig& cfg, const HpcOptions& o
        "    *) echo \"usage: $0 [--from STAGE [--tasks N]]\" >&2; exit 2 ;;\n"
        "  esac\n"
        "done\n";
-  s += fmt::format("case \"$from\" in\n  {}) ;;\n  *) echo \"$0: --from: expected one of {}, got '$from'\" >&2; exit 2 ;;\n"
-                   "esac\n",
-                   fmt::join(names, "|"), fmt::join(names, ", "));
+  s += fmt::format(
+      "case \"$from\" in\n  {}) ;;\n  *) echo \"$0: --from: expected one of {}, got '$from'\" >&2; "
+      "exit 2 ;;\n"
+      "esac\n",
+      fmt::join(names, "|"), fmt::join(names, ", "));
   s += "case \"$tasks\" in\n"
        "  '') ;;\n"
-       "  *[!0-9]* | 0 | 0*) echo \"$0: --tasks: expected a whole number > 0, got '$tasks'\" >&2; exit 2 ;;\n";
+       "  *[!0-9]* | 0 | 0*) echo \"$0: --tasks: expected a whole number > 0, got '$tasks'\" >&2; "
+       "exit 2 ;;\n";
   if (!planned.empty())
-    s += fmt::format("  *) case \"$from\" in {}) ;; *) echo \"$0: --tasks: only with --from {}\" >&2; exit 2 ;; esac ;;\n",
-                     fmt::join(planned, "|"), fmt::join(planned, " or --from "));
+    s += fmt::format(
+        "  *) case \"$from\" in {}) ;; *) echo \"$0: --tasks: only with --from {}\" >&2; exit 2 ;; "
+        "esac ;;\n",
+        fmt::join(planned, "|"), fmt::join(planned, " or --from "));
   else
-    s += "  *) echo \"$0: --tasks: no stage of this chain is planned at run time\" >&2; exit 2 ;;\n";
+    s +=
+        "  *) echo \"$0: --tasks: no stage of this chain is planned at run time\" >&2; exit 2 ;;\n";
   s += "esac\n";
   s += "# Submit a script with sbatch; print its job id. A job whose dependency can never\n"
        "# be met (an earlier stage failed) is cancelled rather than left pending.\n"
-       "submit() { id=$(sbatch --parsable --kill-on-invalid-dep=yes \"$@\") || exit 1; echo \"${id%%;*}\"; }\n"
-       "# The non-empty job ids given, joined with ':' (a stage not submitted by this run is done).\n"
-       "ids() { r=; for i in \"$@\"; do if [ -n \"$i\" ]; then r=\"$r${r:+:}$i\"; fi; done; echo \"$r\"; }\n"
+       "submit() { id=$(sbatch --parsable --kill-on-invalid-dep=yes \"$@\") || exit 1; echo "
+       "\"${id%%;*}\"; }\n"
+       "# The non-empty job ids given, joined with ':' (a stage not submitted by this run is "
+       "done).\n"
+       "ids() { r=; for i in \"$@\"; do if [ -n \"$i\" ]; then r=\"$r${r:+:}$i\"; fi; done; echo "
+       "\"$r\"; }\n"
        "on=\n";
   for (const auto& j : chain) s += fmt::format("{}_done=\n", j.stage);
   for (const auto& j : chain) {
@@ -289,40 +339,52 @@ std::string write_hpc_scripts(const config::CaseConfig& cfg, const HpcOptions& o
     for (const auto& a : j.after) ups.push_back(fmt::format("\"${}_done\"", a));
     s += "\n";
     if (!j.array)
-      s += fmt::format("# {}: one job, after {}.\n", j.stage, j.after.empty() ? "nothing" : fmt::format("{}", fmt::join(j.after, ", ")));
+      s += fmt::format("# {}: one job, after {}.\n", j.stage,
+                       j.after.empty() ? "nothing" : fmt::format("{}", fmt::join(j.after, ", ")));
     else if (j.tasks > 0)
-      s += fmt::format("# {}: an array of {} task{} (one per job), then its merge; after {}.\n", j.stage, j.tasks,
-                       j.tasks == 1 ? "" : "s", j.after.empty() ? "nothing" : fmt::format("{}", fmt::join(j.after, ", ")));
+      s += fmt::format("# {}: an array of {} task{} (one per job), then its merge; after {}.\n",
+                       j.stage, j.tasks, j.tasks == 1 ? "" : "s",
+                       j.after.empty() ? "nothing" : fmt::format("{}", fmt::join(j.after, ", ")));
     else
-      s += fmt::format("# {}: its job count comes from the outputs of {}. A planning job after {}\n"
-                       "# submits the array, its merge and the stages after it (this script with\n"
-                       "# --from {} --tasks N).\n",
-                       j.stage, j.planned_from, fmt::join(j.after, " and "), j.stage);
+      s += fmt::format(
+          "# {}: its job count comes from the outputs of {}. A planning job after {}\n"
+          "# submits the array, its merge and the stages after it (this script with\n"
+          "# --from {} --tasks N).\n",
+          j.stage, j.planned_from, fmt::join(j.after, " and "), j.stage);
     s += fmt::format("if [ \"$from\" = {} ]; then on=1; fi\n", j.stage);
     s += "if [ -n \"$on\" ]; then\n";
-    s += ups.empty() ? std::string("  up=\n") : fmt::format("  up=$(ids {})\n", fmt::join(ups, " "));
+    s +=
+        ups.empty() ? std::string("  up=\n") : fmt::format("  up=$(ids {})\n", fmt::join(ups, " "));
     if (!j.array) {
-      s += fmt::format("  {}_done=$(submit ${{up:+--dependency=afterok:$up}} \"$hpc/{}.sh\")\n", j.stage, j.stage);
+      s += fmt::format("  {}_done=$(submit ${{up:+--dependency=afterok:$up}} \"$hpc/{}.sh\")\n",
+                       j.stage, j.stage);
       s += fmt::format("  echo \"{}: job ${}_done\"\n", j.stage, j.stage);
     } else {
       std::string size;
       if (j.tasks < 0) {
         s += fmt::format("  if [ \"$from\" != {} ] || [ -z \"$tasks\" ]; then\n", j.stage);
-        s += fmt::format("    plan=$(submit ${{up:+--dependency=afterok:$up}} \"$hpc/{}.plan.sh\")\n", j.stage);
-        s += fmt::format("    echo \"{}: planning job $plan (sizes the {} array from the outputs of {}, then submits "
-                         "it and the stages after it)\"\n",
-                         j.stage, j.stage, j.planned_from);
+        s += fmt::format(
+            "    plan=$(submit ${{up:+--dependency=afterok:$up}} \"$hpc/{}.plan.sh\")\n", j.stage);
+        s += fmt::format(
+            "    echo \"{}: planning job $plan (sizes the {} array from the outputs of {}, then "
+            "submits "
+            "it and the stages after it)\"\n",
+            j.stage, j.stage, j.planned_from);
         s += fmt::format("    echo \"logs: {}\"\n", in_dq(logs.string()));
         s += "    exit 0\n  fi\n";
         size = fmt::format(" --array=0-$((tasks - 1)){}", throttle(o));
       }
-      s += fmt::format("  {}_array=$(submit ${{up:+--dependency=afterok:$up}}{} \"$hpc/{}.array.sh\")\n", j.stage, size,
-                       j.stage);
-      s += fmt::format("  {0}_done=$(submit --dependency=afterany:${0}_array${{up:+,afterok:$up}} \"$hpc/{0}.merge.sh\" "
-                       "\"${0}_array\")\n",
-                       j.stage);
-      s += fmt::format("  echo \"{0}: array job ${0}_array ({1} task{2}), merge job ${0}_done\"\n", j.stage,
-                       j.tasks > 0 ? std::to_string(j.tasks) : std::string("$tasks"), j.tasks == 1 ? "" : "s");
+      s += fmt::format(
+          "  {}_array=$(submit ${{up:+--dependency=afterok:$up}}{} \"$hpc/{}.array.sh\")\n",
+          j.stage, size, j.stage);
+      s += fmt::format(
+          "  {0}_done=$(submit --dependency=afterany:${0}_array${{up:+,afterok:$up}} "
+          "\"$hpc/{0}.merge.sh\" "
+          "\"${0}_array\")\n",
+          j.stage);
+      s += fmt::format("  echo \"{0}: array job ${0}_array ({1} task{2}), merge job ${0}_done\"\n",
+                       j.stage, j.tasks > 0 ? std::to_string(j.tasks) : std::string("$tasks"),
+                       j.tasks == 1 ? "" : "s");
     }
     s += "fi\n";
   }
@@ -337,12 +399,15 @@ std::string write_hpc_scripts(const config::CaseConfig& cfg, const HpcOptions& o
   std::string text;
   for (const auto& j : chain) {
     const StageResources& r = j.res;
-    const std::string size = !j.array ? "one job" : j.tasks > 0 ? fmt::format("array of {}", j.tasks) : "array sized by a planning job";
-    text += fmt::format("  {:<10} {:<30} {} rank{}, time {}{}{}\n", j.stage, size, r.np, r.np == 1 ? "" : "s", r.time,
-                        r.mem.empty() ? "" : ", mem " + r.mem, r.partition.empty() ? "" : ", partition " + r.partition);
+    const std::string size = !j.array      ? "one job"
+                             : j.tasks > 0 ? fmt::format("array of {}", j.tasks)
+                                           : "array sized by a planning job";
+    text += fmt::format("  {:<10} {:<30} {} rank{}, time {}{}{}\n", j.stage, size, r.np,
+                        r.np == 1 ? "" : "s", r.time, r.mem.empty() ? "" : ", mem " + r.mem,
+                        r.partition.empty() ? "" : ", partition " + r.partition);
   }
-  return fmt::format("wrote {} scripts in {}:\n{}submit with: sh {}\n", scripts.size(), dir.string(), text,
-                     submit_path.string());
+  return fmt::format("wrote {} scripts in {}:\n{}submit with: sh {}\n", scripts.size(),
+                     dir.string(), text, submit_path.string());
 }
 
 }  // namespace mill

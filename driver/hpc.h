@@ -19,15 +19,15 @@ namespace mill {
 
 struct HpcOptions {
   std::string scheduler = "slurm";
-  std::string stage;                // as given: a stage, FIRST-LAST or all (names the submit script)
+  std::string stage;  // as given: a stage, FIRST-LAST or all (names the submit script)
   std::vector<std::string> stages;  // the stages it stands for, in pipeline order
   std::filesystem::path output;     // run folder
-  int np = 0;                       // --np: ranks per flow task (and per task of a stage scripted alone); 0: not given
-  std::string partition;            // every job's; "": resources.<stage>.partition
-  std::string account;              // optional
-  std::string time;                 // every job's wall-time limit; "": resources.<stage>.time
-  std::string mem;                  // every job's memory, e.g. 4G; "": resources.<stage>.mem
-  int max_parallel = 0;             // %N throttle of the arrays, 0 = none
+  int np = 0;  // --np: ranks per flow task (and per task of a stage scripted alone); 0: not given
+  std::string partition;  // every job's; "": resources.<stage>.partition
+  std::string account;    // optional
+  std::string time;       // every job's wall-time limit; "": resources.<stage>.time
+  std::string mem;        // every job's memory, e.g. 4G; "": resources.<stage>.mem
+  int max_parallel = 0;   // %N throttle of the arrays, 0 = none
 };
 
 // What the jobs of one stage ask of Slurm; each value with where it came from
@@ -44,17 +44,20 @@ struct StageResources {
 // stage's default (the flow takes --np or resources.np ranks; the other MPI
 // stages one rank unless resources.<stage>.np says otherwise, or --np is given
 // for a stage scripted alone).
-StageResources stage_resources(const config::CaseConfig& cfg, const HpcOptions& opt, const std::string& stage);
+StageResources stage_resources(const config::CaseConfig& cfg, const HpcOptions& opt,
+                               const std::string& stage);
 
 // One "#SBATCH --option=value" line: the one place values enter #SBATCH lines.
 // The value must be one printable line without '"' or '\'; it is double-quoted
 // when it holds a blank or '#'. Otherwise a ConfigError names `source`.
-std::string sbatch_directive(const std::string& option, const std::string& value, const std::string& source);
+std::string sbatch_directive(const std::string& option, const std::string& value,
+                             const std::string& source);
 
 // Write the scripts into <output>/hpc/ and return a short text for the user.
 // n_tasks(stage) is the stage's job count now (0: none yet); `exe` is the
 // orchestrate the jobs run. Throws ConfigError on bad options.
 std::string write_hpc_scripts(const config::CaseConfig& cfg, const HpcOptions& opt,
-                              const std::function<int(const std::string&)>& n_tasks, const std::string& exe);
+                              const std::function<int(const std::string&)>& n_tasks,
+                              const std::string& exe);
 
 }  // namespace mill

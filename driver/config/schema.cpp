@@ -60,26 +60,29 @@ const char* kSlurmMemText = "a memory size: a whole number above 0, optional uni
 const char* kSlurmName = "[A-Za-z0-9_.-]+(,[A-Za-z0-9_.-]+)*";
 const char* kSlurmNameText = "a Slurm partition name (letters, digits, '_', '.', '-'; a comma between several)";
 
-// The resources.<stage>.* keys of one stage; `np_default` "" = no ranks key
-// (a stage without MPI), "-" = optional (the code falls back to resources.np).
+// The resources.<stage>.* keys of one stage (`orchestrate hpc`); `job` names
+// one of its Slurm jobs in the docs. `np_default` "" = no ranks key (a stage
+// without MPI), "-" = optional (the code falls back to --np or resources.np).
 std::vector<KeyDef> stage_resources(const std::string& stage, const std::string& time, const std::string& np_default,
-                                    const std::string& what) {
+                                    const std::string& job) {
   const std::string p = "resources." + stage + ".";
   std::vector<KeyDef> v;
   if (np_default == "-")
-    v.push_back(opt(at_least(key(p + "np", KeyType::Int, "", "",
-                                 "Cluster: MPI ranks per " + what + " task; default: --np, else resources.np"),
-                             1)));
+    v.push_back(opt(at_least(
+        key(p + "np", KeyType::Int, "", "", "Cluster: MPI ranks per " + job + "; default: --np, else resources.np"), 1)));
   else if (!np_default.empty())
     v.push_back(at_least(key(p + "np", KeyType::Int, "", np_default,
-                             "Cluster: MPI ranks per " + what + " task (--np overrides when the stage is scripted alone)"),
+                             "Cluster: MPI ranks per " + job + " (--np overrides when the stage is scripted alone)"),
                          1));
-  v.push_back(matching(key(p + "time", KeyType::String, "", time, "Cluster: wall-time limit of each " + what + " job (--time overrides)"),
-                       kSlurmTime, kSlurmTimeText));
-  v.push_back(opt(matching(key(p + "mem", KeyType::String, "", "", "Cluster: memory per " + what + " job (--mem overrides); default: the partition's"),
+  v.push_back(matching(
+      key(p + "time", KeyType::String, "", time, "Cluster: wall-time limit of each " + job + " (--time overrides)"),
+      kSlurmTime, kSlurmTimeText));
+  v.push_back(opt(matching(key(p + "mem", KeyType::String, "", "",
+                               "Cluster: memory of each " + job + " (--mem overrides); default: the partition's"),
                            kSlurmMem, kSlurmMemText)));
   v.push_back(opt(matching(key(p + "partition", KeyType::String, "", "",
-                               "Cluster: Slurm partition of the " + what + " jobs (--partition overrides); default: the cluster's"),
+                               "Cluster: Slurm partition of the " + stage +
+                                   " jobs (--partition overrides); default: the cluster's"),
                            kSlurmName, kSlurmNameText)));
   return v;
 }
@@ -196,12 +199,12 @@ Schema make_case_schema() {
   };
   // Per stage on a cluster: the flow wants ranks, breakage many one-rank tasks.
   for (const auto& [stage, time, np, what] :
-       std::vector<std::array<std::string, 4>>{{"flow", "04:00:00", "-", "flow (one per rotor speed)"},
-                                               {"sample", "00:30:00", "", "sample"},
-                                               {"transport", "02:00:00", "1", "transport (one per rotor speed)"},
-                                               {"calibrate", "02:00:00", "1", "calibration"},
-                                               {"breakage", "01:00:00", "1", "breakage (one per impact)"},
-                                               {"report", "00:30:00", "", "report"}})
+       std::vector<std::array<std::string, 4>>{{"flow", "04:00:00", "-", "flow task (one per rotor speed)"},
+                                               {"sample", "00:30:00", "", "sample job"},
+                                               {"transport", "02:00:00", "1", "transport task (one per rotor speed)"},
+                                               {"calibrate", "02:00:00", "1", "calibration job"},
+                                               {"breakage", "01:00:00", "1", "breakage task (one per impact condition)"},
+                                               {"report", "00:30:00", "", "report job"}})
     for (auto& k : stage_resources(stage, time, np, what)) s.keys.push_back(std::move(k));
   return s;
 }

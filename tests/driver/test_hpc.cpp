@@ -91,7 +91,8 @@ TEST(HpcStages, RangesExpandInPipelineOrder) {
     mill::resolve_stages("transprt-breakage");
     FAIL() << "a misspelt range was accepted";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("did you mean 'transport'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("did you mean 'transport'"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -106,9 +107,9 @@ TEST(HpcScripts, WholeChainHasOneScriptPerStageAndAPlannedBreakageArray) {
   o.np = 2;
   const std::string text = mill::write_hpc_scripts(tiny(), o, count, "/opt/mill/orchestrate");
   const fs::path h = out / "hpc";
-  for (const char* f : {"flow.array.sh", "flow.merge.sh", "sample.sh", "transport.array.sh", "transport.merge.sh",
-                        "calibrate.sh", "breakage.plan.sh", "breakage.array.sh", "breakage.merge.sh", "report.sh",
-                        "submit_all.sh"})
+  for (const char* f : {"flow.array.sh", "flow.merge.sh", "sample.sh", "transport.array.sh",
+                        "transport.merge.sh", "calibrate.sh", "breakage.plan.sh",
+                        "breakage.array.sh", "breakage.merge.sh", "report.sh", "submit_all.sh"})
     EXPECT_TRUE(fs::exists(h / f)) << f << "\n" << text;
   EXPECT_FALSE(fs::exists(h / "sample.array.sh"));
   // The breakage count is never taken before the transport has run.
@@ -120,7 +121,8 @@ TEST(HpcScripts, WholeChainHasOneScriptPerStageAndAPlannedBreakageArray) {
   EXPECT_NE(flow.find("#SBATCH --array=0-0\n"), std::string::npos) << flow;
   EXPECT_NE(flow.find("#SBATCH --time=00:15:00\n"), std::string::npos) << flow;
   EXPECT_NE(flow.find("#SBATCH --job-name=mill-tiny_hpc-flow\n"), std::string::npos) << flow;
-  EXPECT_NE(slurp(h / "flow.array.sh").find("--stage flow --task \"$SLURM_ARRAY_TASK_ID\" --np 2 --jobs 1"),
+  EXPECT_NE(slurp(h / "flow.array.sh")
+                .find("--stage flow --task \"$SLURM_ARRAY_TASK_ID\" --np 2 --jobs 1"),
             std::string::npos);
   // Breakage: one rank per task, the case's memory, and no --array: the
   // planning job passes it.
@@ -132,12 +134,16 @@ TEST(HpcScripts, WholeChainHasOneScriptPerStageAndAPlannedBreakageArray) {
   const std::string plan = slurp(h / "breakage.plan.sh");
   EXPECT_NE(plan.find("--stage breakage --list-tasks"), std::string::npos) << plan;
   EXPECT_NE(plan.find("--from breakage --tasks \"$n\""), std::string::npos) << plan;
-  EXPECT_NE(directives(h / "breakage.plan.sh").find("#SBATCH --time=00:05:00\n"), std::string::npos);
+  EXPECT_NE(directives(h / "breakage.plan.sh").find("#SBATCH --time=00:05:00\n"),
+            std::string::npos);
   // Merges run no job themselves.
-  EXPECT_NE(slurp(h / "transport.merge.sh").find("--stage transport --merge-only"), std::string::npos);
+  EXPECT_NE(slurp(h / "transport.merge.sh").find("--stage transport --merge-only"),
+            std::string::npos);
   EXPECT_NE(directives(h / "transport.merge.sh").find("#SBATCH --ntasks=1\n"), std::string::npos);
   // Logs: per array task and per job, in hpc/logs.
-  EXPECT_NE(flow.find("#SBATCH --output=" + (h / "logs").string() + "/%x_%A_%a.out\n"), std::string::npos) << flow;
+  EXPECT_NE(flow.find("#SBATCH --output=" + (h / "logs").string() + "/%x_%A_%a.out\n"),
+            std::string::npos)
+      << flow;
   EXPECT_NE(directives(h / "sample.sh").find("/%x_%j.out\n"), std::string::npos);
 }
 
@@ -148,10 +154,16 @@ struct FakeSlurm {
     fs::create_directories(dir);
     write_exe(dir / "sbatch",
               "#!/bin/sh\n"
-              "n=$(( $(cat '" + (dir / "n").string() + "' 2>/dev/null || echo 100) + 1 ))\n"
-              "echo $n > '" + (dir / "n").string() + "'\n"
-              "echo \"$n $*\" >> '" + log.string() + "'\n"
-              "echo \"$n;milltest\"\n");
+              "n=$(( $(cat '" +
+                  (dir / "n").string() +
+                  "' 2>/dev/null || echo 100) + 1 ))\n"
+                  "echo $n > '" +
+                  (dir / "n").string() +
+                  "'\n"
+                  "echo \"$n $*\" >> '" +
+                  log.string() +
+                  "'\n"
+                  "echo \"$n;milltest\"\n");
   }
   std::string env() const { return "PATH='" + dir.string() + "':\"$PATH\" "; }
   // The logged call of a script: "<id> <options> <script path> <args>".
@@ -174,27 +186,36 @@ TEST(HpcScripts, SubmitChainsStagesWithAfterokAndThePlanningJobSubmitsTheRest) {
             "*) exit 9 ;; esac\n");
   HpcOptions o = options("all", out / "run");
   o.max_parallel = 2;
-  mill::write_hpc_scripts(tiny(), o, [](const std::string&) { return 1; }, (out / "orchestrate").string());
+  mill::write_hpc_scripts(
+      tiny(), o, [](const std::string&) { return 1; }, (out / "orchestrate").string());
   const fs::path h = out / "run" / "hpc";
   FakeSlurm slurm(out);
 
   auto [st, text] = sh(slurm.env() + "sh '" + (h / "submit_all.sh").string() + "'");
   ASSERT_EQ(st, 0) << text;
   // Ids from 101 on, in submission order.
-  EXPECT_EQ(slurm.call_of("flow.array.sh"), "101 --parsable --kill-on-invalid-dep=yes " + (h / "flow.array.sh").string());
+  EXPECT_EQ(slurm.call_of("flow.array.sh"),
+            "101 --parsable --kill-on-invalid-dep=yes " + (h / "flow.array.sh").string());
   EXPECT_EQ(slurm.call_of("flow.merge.sh"),
-            "102 --parsable --kill-on-invalid-dep=yes --dependency=afterany:101 " + (h / "flow.merge.sh").string() + " 101");
+            "102 --parsable --kill-on-invalid-dep=yes --dependency=afterany:101 " +
+                (h / "flow.merge.sh").string() + " 101");
   EXPECT_EQ(slurm.call_of("sample.sh"),
-            "103 --parsable --kill-on-invalid-dep=yes --dependency=afterok:102 " + (h / "sample.sh").string());
+            "103 --parsable --kill-on-invalid-dep=yes --dependency=afterok:102 " +
+                (h / "sample.sh").string());
   EXPECT_EQ(slurm.call_of("transport.array.sh"),
-            "104 --parsable --kill-on-invalid-dep=yes --dependency=afterok:103 " + (h / "transport.array.sh").string());
-  EXPECT_EQ(slurm.call_of("transport.merge.sh"), "105 --parsable --kill-on-invalid-dep=yes --dependency=afterany:104,afterok:103 " +
-                                                     (h / "transport.merge.sh").string() + " 104");
+            "104 --parsable --kill-on-invalid-dep=yes --dependency=afterok:103 " +
+                (h / "transport.array.sh").string());
+  EXPECT_EQ(slurm.call_of("transport.merge.sh"),
+            "105 --parsable --kill-on-invalid-dep=yes --dependency=afterany:104,afterok:103 " +
+                (h / "transport.merge.sh").string() + " 104");
   // The calibration reads no earlier stage: it runs beside the flow chain.
-  EXPECT_EQ(slurm.call_of("calibrate.sh"), "106 --parsable --kill-on-invalid-dep=yes " + (h / "calibrate.sh").string());
+  EXPECT_EQ(slurm.call_of("calibrate.sh"),
+            "106 --parsable --kill-on-invalid-dep=yes " + (h / "calibrate.sh").string());
   EXPECT_EQ(slurm.call_of("breakage.plan.sh"),
-            "107 --parsable --kill-on-invalid-dep=yes --dependency=afterok:105:106 " + (h / "breakage.plan.sh").string());
-  EXPECT_EQ(slurm.call_of("breakage.array.sh"), "") << "the breakage array is the planning job's to submit";
+            "107 --parsable --kill-on-invalid-dep=yes --dependency=afterok:105:106 " +
+                (h / "breakage.plan.sh").string());
+  EXPECT_EQ(slurm.call_of("breakage.array.sh"), "")
+      << "the breakage array is the planning job's to submit";
   EXPECT_NE(text.find("breakage: planning job 107"), std::string::npos) << text;
 
   // The planning job, run by hand: three jobs -> an array of three (throttled), then the rest.
@@ -202,14 +223,18 @@ TEST(HpcScripts, SubmitChainsStagesWithAfterokAndThePlanningJobSubmitsTheRest) {
   ASSERT_EQ(pst, 0) << ptext;
   EXPECT_NE(ptext.find("stage breakage: 3 jobs"), std::string::npos) << ptext;
   EXPECT_EQ(slurm.call_of("breakage.array.sh"),
-            "108 --parsable --kill-on-invalid-dep=yes --array=0-2%2 " + (h / "breakage.array.sh").string());
-  EXPECT_EQ(slurm.call_of("breakage.merge.sh"), "109 --parsable --kill-on-invalid-dep=yes --dependency=afterany:108 " +
-                                                    (h / "breakage.merge.sh").string() + " 108");
+            "108 --parsable --kill-on-invalid-dep=yes --array=0-2%2 " +
+                (h / "breakage.array.sh").string());
+  EXPECT_EQ(slurm.call_of("breakage.merge.sh"),
+            "109 --parsable --kill-on-invalid-dep=yes --dependency=afterany:108 " +
+                (h / "breakage.merge.sh").string() + " 108");
   EXPECT_EQ(slurm.call_of("report.sh"),
-            "110 --parsable --kill-on-invalid-dep=yes --dependency=afterok:109 " + (h / "report.sh").string());
+            "110 --parsable --kill-on-invalid-dep=yes --dependency=afterok:109 " +
+                (h / "report.sh").string());
 
   // A plan with no jobs fails the planning job and submits nothing.
-  write_exe(out / "orchestrate", "#!/bin/sh\necho '# breakage: no tasks yet: waits for transport'\n");
+  write_exe(out / "orchestrate",
+            "#!/bin/sh\necho '# breakage: no tasks yet: waits for transport'\n");
   const std::string before = slurp(slurm.log);
   auto [est, etext] = sh(slurm.env() + "bash '" + (h / "breakage.plan.sh").string() + "'");
   EXPECT_EQ(est, 1) << etext;
@@ -217,17 +242,26 @@ TEST(HpcScripts, SubmitChainsStagesWithAfterokAndThePlanningJobSubmitsTheRest) {
   EXPECT_EQ(slurp(slurm.log), before);
 
   // Bad arguments to the submit script.
-  EXPECT_EQ(sh(slurm.env() + "sh '" + (h / "submit_all.sh").string() + "' --from breakge").first, 2);
-  EXPECT_EQ(sh(slurm.env() + "sh '" + (h / "submit_all.sh").string() + "' --from report --tasks 3").first, 2);
-  EXPECT_EQ(sh(slurm.env() + "sh '" + (h / "submit_all.sh").string() + "' --from breakage --tasks x").first, 2);
+  EXPECT_EQ(sh(slurm.env() + "sh '" + (h / "submit_all.sh").string() + "' --from breakge").first,
+            2);
+  EXPECT_EQ(
+      sh(slurm.env() + "sh '" + (h / "submit_all.sh").string() + "' --from report --tasks 3").first,
+      2);
+  EXPECT_EQ(
+      sh(slurm.env() + "sh '" + (h / "submit_all.sh").string() + "' --from breakage --tasks x")
+          .first,
+      2);
 }
 
 TEST(HpcScripts, SubmitStopsWhenSbatchFails) {
   const fs::path out = fresh_dir("sbatch_fails");
-  mill::write_hpc_scripts(tiny(), options("all", out / "run"), [](const std::string&) { return 1; }, "/bin/false");
+  mill::write_hpc_scripts(
+      tiny(), options("all", out / "run"), [](const std::string&) { return 1; }, "/bin/false");
   fs::create_directories(out / "bin");
-  write_exe(out / "bin" / "sbatch", "#!/bin/sh\necho 'sbatch: error: invalid partition' >&2\nexit 1\n");
-  auto [st, text] = sh("PATH='" + (out / "bin").string() + "':\"$PATH\" sh '" + (out / "run/hpc/submit_all.sh").string() + "'");
+  write_exe(out / "bin" / "sbatch",
+            "#!/bin/sh\necho 'sbatch: error: invalid partition' >&2\nexit 1\n");
+  auto [st, text] = sh("PATH='" + (out / "bin").string() + "':\"$PATH\" sh '" +
+                       (out / "run/hpc/submit_all.sh").string() + "'");
   EXPECT_NE(st, 0) << text;
   EXPECT_NE(text.find("invalid partition"), std::string::npos) << text;
   EXPECT_EQ(text.find("flow: array job"), std::string::npos) << text;
@@ -235,20 +269,23 @@ TEST(HpcScripts, SubmitStopsWhenSbatchFails) {
 
 TEST(HpcScripts, BreakageAfterADoneTransportHasItsArraySizeNow) {
   const fs::path out = fresh_dir("known");
-  const std::string text =
-      mill::write_hpc_scripts(tiny(), options("breakage-report", out), [](const std::string&) { return 5; }, "/bin/true");
+  const std::string text = mill::write_hpc_scripts(
+      tiny(), options("breakage-report", out), [](const std::string&) { return 5; }, "/bin/true");
   const fs::path h = out / "hpc";
   EXPECT_NE(directives(h / "breakage.array.sh").find("#SBATCH --array=0-4\n"), std::string::npos);
   EXPECT_FALSE(fs::exists(h / "breakage.plan.sh"));
   const std::string submit = slurp(h / "submit_breakage-report.sh");
-  EXPECT_NE(submit.find("report_done=$(submit ${up:+--dependency=afterok:$up}"), std::string::npos) << submit;
+  EXPECT_NE(submit.find("report_done=$(submit ${up:+--dependency=afterok:$up}"), std::string::npos)
+      << submit;
   EXPECT_NE(submit.find("up=$(ids \"$breakage_done\")"), std::string::npos) << submit;
   // Transport not run yet and not in the range: say which range to script.
   try {
-    mill::write_hpc_scripts(tiny(), options("breakage", out), [](const std::string&) { return 0; }, "/bin/true");
+    mill::write_hpc_scripts(
+        tiny(), options("breakage", out), [](const std::string&) { return 0; }, "/bin/true");
     FAIL() << "a breakage array of no tasks was written";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("--stage transport-breakage"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--stage transport-breakage"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -294,14 +331,16 @@ TEST(HpcDirective, QuotesBlanksAndRejectsLineBreaks) {
             "#SBATCH --output=\"/runs/my case/%x_%j.out\"\n");
   EXPECT_EQ(mill::sbatch_directive("--output", "/runs/#1/%x_%j.out", "--output"),
             "#SBATCH --output=\"/runs/#1/%x_%j.out\"\n");
-  for (const std::string& bad : {std::string("big\n#SBATCH --exclusive"), std::string("a\"b"), std::string("a\\b"),
-                                std::string("a\tb"), std::string("")}) {
+  for (const std::string& bad : {std::string("big\n#SBATCH --exclusive"), std::string("a\"b"),
+                                 std::string("a\\b"), std::string("a\tb"), std::string("")}) {
     try {
       mill::sbatch_directive("--partition", bad, "resources.flow.partition");
       ADD_FAILURE() << "accepted '" << bad << "'";
     } catch (const ConfigError& e) {
-      EXPECT_NE(std::string(e.what()).find("resources.flow.partition"), std::string::npos) << e.what();
-      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << "message not on one line: " << e.what();
+      EXPECT_NE(std::string(e.what()).find("resources.flow.partition"), std::string::npos)
+          << e.what();
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos)
+          << "message not on one line: " << e.what();
     }
   }
 }
@@ -311,7 +350,8 @@ TEST(HpcScripts, OptionValuesAreCheckedBeforeAnyScriptIsWritten) {
   HpcOptions o = options("all", out);
   o.account = "proj\nx";
   try {
-    mill::write_hpc_scripts(tiny(), o, [](const std::string&) { return 1; }, "/bin/true");
+    mill::write_hpc_scripts(
+        tiny(), o, [](const std::string&) { return 1; }, "/bin/true");
     FAIL() << "an account with a newline was written";
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("--account"), std::string::npos) << e.what();
@@ -319,14 +359,20 @@ TEST(HpcScripts, OptionValuesAreCheckedBeforeAnyScriptIsWritten) {
   }
   EXPECT_FALSE(fs::exists(out / "hpc" / "submit_all.sh"));
   HpcOptions pct = options("all", out / "100%");
-  EXPECT_THROW(mill::write_hpc_scripts(tiny(), pct, [](const std::string&) { return 1; }, "/bin/true"), ConfigError);
+  EXPECT_THROW(mill::write_hpc_scripts(
+                   tiny(), pct, [](const std::string&) { return 1; }, "/bin/true"),
+               ConfigError);
 }
 
 TEST(HpcScripts, RunFolderWithBlanksIsQuoted) {
   const fs::path out = fresh_dir("blank") / "my run";
-  mill::write_hpc_scripts(tiny(), options("flow", out), [](const std::string&) { return 1; }, "/opt/my mill/orchestrate");
+  mill::write_hpc_scripts(
+      tiny(), options("flow", out), [](const std::string&) { return 1; },
+      "/opt/my mill/orchestrate");
   const std::string a = slurp(out / "hpc" / "flow.array.sh");
-  EXPECT_NE(a.find("#SBATCH --output=\"" + (out / "hpc/logs").string() + "/%x_%A_%a.out\"\n"), std::string::npos) << a;
+  EXPECT_NE(a.find("#SBATCH --output=\"" + (out / "hpc/logs").string() + "/%x_%A_%a.out\"\n"),
+            std::string::npos)
+      << a;
   EXPECT_NE(a.find("exec '/opt/my mill/orchestrate' --case "), std::string::npos) << a;
   EXPECT_NE(a.find("--output '" + out.string() + "'"), std::string::npos) << a;
 }

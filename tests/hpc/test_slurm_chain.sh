@@ -67,7 +67,7 @@ for f in flow.array.sh flow.merge.sh sample.sh transport.array.sh transport.merg
   [ -f "$run/hpc/$f" ] || fail "orchestrate hpc --stage all did not write $f"
 done
 # The breakage array size is not in its script: the planning job finds it.
-! grep -q -- '--array' "$run/hpc/breakage.array.sh" || fail "breakage.array.sh has an --array written by hand"
+! grep -q '^#SBATCH --array' "$run/hpc/breakage.array.sh" || fail "breakage.array.sh has an --array written by hand"
 grep -q '^#SBATCH --ntasks=2$' "$run/hpc/flow.array.sh" || fail "the flow tasks do not ask for --np 2 ranks"
 
 # --- first submission: one breakage impact fails ---
