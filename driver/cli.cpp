@@ -110,8 +110,8 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
   hpc->add_option("--scheduler", hpc_opt.scheduler, "Scheduler (slurm)")->capture_default_str();
   hpc->add_option("--partition", hpc_opt.partition, "Slurm partition of every job (default: resources.<stage>.partition)");
   hpc->add_option("--account", hpc_opt.account, "Slurm account");
-  hpc->add_option("--time", hpc_opt.time, "Wall-time limit of every task (HH:MM:SS; default: resources.<stage>.time)");
-  hpc->add_option("--mem", hpc_opt.mem, "Memory per task, e.g. 4G (default: resources.<stage>.mem)");
+  hpc->add_option("--time", hpc_opt.time, "Wall-time limit of every job (HH:MM:SS; default: resources.<stage>.time)");
+  hpc->add_option("--mem", hpc_opt.mem, "Memory of every job, e.g. 4G (default: resources.<stage>.mem)");
   hpc->add_option("--max-parallel", hpc_opt.max_parallel, "At most this many tasks at once (0: no limit)");
   hpc->footer("\nExamples:\n  orchestrate hpc --scheduler slurm --stage all --case cases/reference.yaml --np 16\n"
               "  sh runs/reference/hpc/submit_all.sh\n"

@@ -212,7 +212,8 @@ std::string write_hpc_scripts(const config::CaseConfig& cfg, const HpcOptions& o
     }
     std::string a =
         header(o, name, j.res.np, j.res.time, j.res.time_from, j.res, true, logs, "%x_%A_%a");
-    if (j.tasks > 0) a += fmt::format("#SBATCH --array=0-{}{}\n", j.tasks - 1, throttle(o));
+    if (j.tasks > 0)
+      a += sbatch_directive("--array", fmt::format("0-{}{}", j.tasks - 1, throttle(o)), "the stage's job count");
     a += fmt::format(
         "# Stage {} of case '{}': array task I runs job I of `orchestrate --stage {} "
         "--list-tasks`\n"
