@@ -28,7 +28,8 @@ std::string project_dir() {
 namespace {
 
 const char* kExamples = R"(
-Stages, in order: flow, sample, transport, calibrate, breakage, report (or all).
+Stages, in order: flow, sample, transport, calibrate, breakage, report (or all,
+or a range such as transport-breakage).
 
 Examples:
   orchestrate --stage all                        run everything on the default case
@@ -38,6 +39,7 @@ Examples:
   orchestrate --stage flow --np 4                the CFD on 4 MPI ranks
   orchestrate --stage breakage --list-tasks      one job per line (HPC array units)
   orchestrate --stage breakage --task 7          run job 7 only (e.g. $SLURM_ARRAY_TASK_ID)
+  orchestrate hpc --scheduler slurm --stage all  Slurm scripts chaining every stage (docs/hpc.md)
   orchestrate --print-schema > docs/config.md    every case-file and ore-card key
 
 A rerun of the same command resumes: done jobs whose inputs did not change are
@@ -97,9 +99,10 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
   std::string case_file = (fs::path(project_dir()) / "cases" / "default.yaml").string();
   std::string stage, output;
   int np = 0, jobs = 0, task = -1;
-  bool dry_run = false, list_tasks = false, force = false, print_schema = false, check = false;
+  bool dry_run = false, list_tasks = false, force = false, print_schema = false, check = false, merge_only = false;
   app.add_option("-c,--case", case_file, "Case file (YAML)")->capture_default_str();
-  app.add_option("-s,--stage", stage, "Stage to run: flow, sample, transport, calibrate, breakage, report, all");
+  app.add_option("-s,--stage", stage,
+                 "Stage to run: flow, sample, transport, calibrate, breakage, report, all, or a range FIRST-LAST");
   app.add_option("-o,--output", output, "Run folder (default: runs/<case name>)");
   app.add_option("--np", np, "MPI ranks per engine run (default: resources.np of the case)")
       ->check(decimal(1, 100000, true, "ranks"));
@@ -109,6 +112,9 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
   app.add_flag("--list-tasks", list_tasks, "List the jobs of the stage, one per line: index, label, state, summary");
   app.add_option("--task", task, "Run only job I (0-based) of the stage: one HPC array task")
       ->check(decimal(0, 10000000, true, "task"));
+  app.add_flag("--merge-only", merge_only,
+               "Run no job: merge the stage if every job is done, else name the jobs that are not and exit 1 (the "
+               "merge job of `orchestrate hpc`)");
   app.add_flag("-f,--force", force, "Redo jobs that are already done");
   app.add_flag("--print-schema", print_schema, "Print every case-file and ore-card key as Markdown");
   app.add_flag("--check", check, "Validate the case file and its ore card, then exit");
@@ -136,17 +142,21 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
   impact->footer("\nExample:\n  orchestrate impact --velocity 100 --angle 60 --ore granite --elements 400 --output try1\n");
   impact->fallthrough();
 
-  // orchestrate hpc: scheduler scripts for one stage.
+  // orchestrate hpc: scheduler scripts for a stage or a chain of stages.
   HpcOptions hpc_opt;
-  CLI::App* hpc = app.add_subcommand("hpc", "Write Slurm job-array scripts for one stage (one task per job)");
+  CLI::App* hpc = app.add_subcommand(
+      "hpc", "Write Slurm scripts for a stage or a range of stages (arrays of one task per job, chained with "
+             "--dependency=afterok) and the script that submits them");
   hpc->add_option("--scheduler", hpc_opt.scheduler, "Scheduler (slurm)")->capture_default_str();
-  hpc->add_option("--partition", hpc_opt.partition, "Slurm partition");
+  hpc->add_option("--partition", hpc_opt.partition, "Slurm partition of every job (default: resources.<stage>.partition)");
   hpc->add_option("--account", hpc_opt.account, "Slurm account");
-  hpc->add_option("--time", hpc_opt.time, "Wall-time limit per array task (HH:MM:SS)")->capture_default_str();
-  hpc->add_option("--mem", hpc_opt.mem, "Memory per task, e.g. 4G");
+  hpc->add_option("--time", hpc_opt.time, "Wall-time limit of every job (HH:MM:SS; default: resources.<stage>.time)");
+  hpc->add_option("--mem", hpc_opt.mem, "Memory of every job, e.g. 4G (default: resources.<stage>.mem)");
   hpc->add_option("--max-parallel", hpc_opt.max_parallel, "At most this many tasks at once (0: no limit)")
       ->check(decimal(0, 100000, true, "tasks"));
-  hpc->footer("\nExample:\n  orchestrate hpc --scheduler slurm --stage breakage --case cases/reference.yaml --np 1\n"
+  hpc->footer("\nExamples:\n  orchestrate hpc --scheduler slurm --stage all --case cases/reference.yaml --np 16\n"
+              "  sh runs/reference/hpc/submit_all.sh\n"
+              "  orchestrate hpc --scheduler slurm --stage breakage --case cases/reference.yaml\n"
               "  sh runs/reference/hpc/submit_breakage.sh\n");
   hpc->fallthrough();
 
@@ -185,18 +195,21 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
     }
     const auto cfg = config::load_case(case_file, project_dir());
     if (*hpc) {
-      if (stage.empty()) throw config::ConfigError("--stage: hpc needs the stage whose jobs become array tasks");
-      resolve_stages(stage);
+      if (stage.empty())
+        throw config::ConfigError("--stage: hpc needs the stages to script: one stage, a range FIRST-LAST or all");
+      hpc_opt.stages = resolve_stages(stage);
       hpc_opt.stage = stage;
       hpc_opt.output = fs::absolute(output.empty() ? fs::path("runs") / cfg.name : fs::path(output));
       check_output_path(hpc_opt.output);
       check_run_folder(cfg, hpc_opt.output, force);
-      hpc_opt.np = np > 0 ? np : static_cast<int>(cfg.doc.integer("resources.np"));
-      Invocation inv;
-      inv.stages = {stage};
-      inv.opts.output = hpc_opt.output;
-      const int n = count_tasks(cfg, inv);
-      out << write_hpc_scripts(cfg, hpc_opt, n, fs::canonical("/proc/self/exe").string());
+      hpc_opt.np = np;  // 0: not given; the stages' resources decide
+      const auto n_tasks = [&](const std::string& s) {
+        Invocation inv;
+        inv.stages = {s};
+        inv.opts.output = hpc_opt.output;
+        return count_tasks(cfg, inv);
+      };
+      out << write_hpc_scripts(cfg, hpc_opt, n_tasks, fs::canonical("/proc/self/exe").string());
       return 0;
     }
     if (check) {
@@ -218,8 +231,11 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
     inv.opts.np = np > 0 ? np : static_cast<int>(cfg.doc.integer("resources.np"));
     inv.opts.jobs = jobs > 0 ? jobs : static_cast<int>(cfg.doc.integer("resources.jobs"));
     inv.opts.force = force;
+    if (const char* job = std::getenv("MILL_SCHEDULER_JOB")) inv.opts.scheduler_job = job;
+    if (const char* log = std::getenv("MILL_SCHEDULER_LOG")) inv.opts.scheduler_log = log;
     inv.dry_run = dry_run;
     inv.list_tasks = list_tasks;
+    inv.merge_only = merge_only;
     if (task >= 0) inv.task = task;
     return run_pipeline(cfg, inv, out);
   } catch (const config::ConfigError& e) {

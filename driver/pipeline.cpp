@@ -24,18 +24,36 @@
 namespace mill {
 namespace fs = std::filesystem;
 
-std::vector<std::string> resolve_stages(const std::string& stage) {
+namespace {
+// One stage name, or a ConfigError naming --stage (with a "did you mean").
+size_t stage_index(const std::string& stage, const std::string& given) {
   const auto& names = stage_names();
-  if (stage == "all") return names;
-  if (std::find(names.begin(), names.end(), stage) != names.end()) return {stage};
+  const auto it = std::find(names.begin(), names.end(), stage);
+  if (it != names.end()) return static_cast<size_t>(it - names.begin());
   std::string list;
   for (const auto& n : names) list += n + ", ";
   std::string hint;
   size_t best = 99;
   for (const auto& n : names)
     if (config::edit_distance(stage, n) < best) best = config::edit_distance(stage, n), hint = n;
-  throw config::ConfigError(fmt::format("--stage: expected one of {}all, got '{}'{}", list, stage,
-                                        best <= 2 ? "; did you mean '" + hint + "'?" : ""));
+  throw config::ConfigError(fmt::format("--stage: expected one of {}all or a range FIRST-LAST (e.g. transport-breakage), "
+                                        "got '{}'{}",
+                                        list, given, best <= 2 ? "; did you mean '" + hint + "'?" : ""));
+}
+}  // namespace
+
+std::vector<std::string> resolve_stages(const std::string& stage) {
+  const auto& names = stage_names();
+  if (stage == "all") return names;
+  const size_t dash = stage.find('-');
+  if (dash == std::string::npos) return {names[stage_index(stage, stage)]};
+  // A range FIRST-LAST: every stage from FIRST to LAST in pipeline order.
+  const size_t first = stage_index(stage.substr(0, dash), stage), last = stage_index(stage.substr(dash + 1), stage);
+  if (first > last)
+    throw config::ConfigError(fmt::format("--stage {}: '{}' comes after '{}' in the pipeline; expected FIRST-LAST in "
+                                          "pipeline order, e.g. {}-{}",
+                                          stage, names[first], names[last], names[last], names[first]));
+  return {names.begin() + static_cast<long>(first), names.begin() + static_cast<long>(last) + 1};
 }
 
 namespace {
@@ -99,7 +117,7 @@ void write_provenance(const config::CaseConfig& cfg, const fs::path& run_dir) {
 
 // Run one job with its STATUS bookkeeping. Returns "" on success, else the reason.
 std::string run_one(Stage& stage, StageContext& ctx, const jobs::JobStore& store, const JobSpec& job) {
-  store.mark_running(job.label, job.inputs);
+  store.mark_running(job.label, job.inputs, ctx.opts.scheduler_job, ctx.opts.scheduler_log);
   const auto t0 = std::chrono::steady_clock::now();
   ctx.progress.job_begin(job.label);
   std::string reason;
@@ -125,6 +143,25 @@ std::string run_one(Stage& stage, StageContext& ctx, const jobs::JobStore& store
   return reason;
 }
 
+// Why a job that is not done is not: its STATUS, with the scheduler job and
+// log that last ran it (for the merge job of a scheduler chain).
+std::string not_done_text(const jobs::JobStore& store, const JobRow& r) {
+  const jobs::Status s = store.read_status(r.spec.label);
+  std::string why;
+  switch (s.state) {
+    case jobs::State::None: why = "not run: no STATUS (its task did not start, or failed before the job did)"; break;
+    case jobs::State::Running:
+      why = fmt::format("did not finish: STATUS still says running as pid {} on {} (killed, e.g. at the time limit?)",
+                        s.pid, s.host);
+      break;
+    case jobs::State::Failed: why = "failed: " + s.reason; break;
+    default: why = r.verdict.why; break;
+  }
+  if (!s.scheduler_job.empty()) why += fmt::format("; scheduler job {}", s.scheduler_job);
+  if (!s.log.empty()) why += fmt::format(", log {}", s.log);
+  return why;
+}
+
 }  // namespace
 
 int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostream& out) {
@@ -133,6 +170,8 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
   Progress progress(out, isatty(STDOUT_FILENO) && &out == &std::cout);
   const fs::path run_dir = inv.opts.output;
 
+  if (inv.task && inv.merge_only)
+    throw config::ConfigError("--merge-only: runs no job, so it takes no --task");
   if (inv.task && inv.stages.size() != 1)
     throw config::ConfigError("--task: needs exactly one --stage (the stage whose job list --list-tasks shows), not 'all'");
   bool provenance_written = false;
@@ -180,6 +219,24 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
       for (size_t i = 0; i < rows.size(); ++i)
         out << fmt::format("  [{}] {:>3} {:<22} {} ({}, id {})\n", verdict_tag(rows[i].verdict), i, rows[i].spec.label,
                            rows[i].spec.summary, rows[i].verdict.why, jobs::job_id(rows[i].spec.inputs));
+      continue;
+    }
+
+    if (inv.merge_only) {
+      // After a scheduler ran the jobs: merge only when every job is done.
+      std::vector<std::string> missing;
+      for (size_t i = 0; i < rows.size(); ++i)
+        if (rows[i].verdict.decision != jobs::Decision::Skip)
+          missing.push_back(fmt::format("{}/{} (task {}): {}", name, rows[i].spec.label, i, not_done_text(store, rows[i])));
+      if (rows.empty() && !plan.note.empty()) missing.push_back(fmt::format("{}: no jobs: {}", name, plan.note));
+      for (const auto& m : missing) out << "error: " << m << "\n";
+      if (!missing.empty()) {
+        out << fmt::format("stage '{}': {} of {} job(s) not done; nothing merged.\n", name, missing.size(), rows.size());
+        return kExitFailed;
+      }
+      if (!provenance_written) write_provenance(cfg, run_dir), provenance_written = true;
+      stage.finalize(ctx, plan.jobs);
+      out << fmt::format("stage '{}': all {} job(s) done; merged.\n", name, rows.size());
       continue;
     }
 

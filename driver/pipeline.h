@@ -26,6 +26,7 @@ struct Invocation {
   bool dry_run = false;
   bool list_tasks = false;
   std::optional<int> task;  // run only job I of the (single) stage
+  bool merge_only = false;  // run no job: merge if every job is done, else name those that are not
 };
 
 // Run the invocation; returns an ExitCode (or 128+signal when interrupted).
@@ -42,7 +43,8 @@ void check_run_folder(const config::CaseConfig& cfg, const std::filesystem::path
 // Number of jobs the (single) stage of `inv` has for this case.
 int count_tasks(const config::CaseConfig& cfg, const Invocation& inv);
 
-// Expand "all" to every stage, validate names (ConfigError naming --stage).
+// Expand "all" or a range FIRST-LAST ("transport-breakage") to its stages in
+// pipeline order; validate names (ConfigError naming --stage).
 std::vector<std::string> resolve_stages(const std::string& stage);
 
 }  // namespace mill

@@ -11,7 +11,9 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <cctype>
 #include <fstream>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -42,6 +44,13 @@ std::string scalar_text(const YAML::Node& n) {
   if (n.IsSequence()) return "a list";
   if (n.IsMap()) return "a section";
   return "nothing";
+}
+
+// A value in a message: quoted, control characters as \\xNN (one line).
+std::string shown(const std::string& v) {
+  std::string o = "'";
+  for (unsigned char c : v) o += std::iscntrl(c) ? fmt::format("\\x{:02x}", c) : std::string(1, static_cast<char>(c));
+  return o + "'";
 }
 
 int line_of(const YAML::Node& n) { return n.Mark().line >= 0 ? n.Mark().line + 1 : 0; }
@@ -147,6 +156,8 @@ class Validator {
       case KeyType::Path:
         if (!n.IsScalar() || n.Scalar().empty())
           fail(line, k.path, fmt::format("expected {}, got {}", type_name(k.type), scalar_text(n)));
+        if (!k.pattern.empty() && !std::regex_match(n.Scalar(), std::regex(k.pattern)))
+          fail(line, k.path, fmt::format("expected {}, got {}", expected_text(k), shown(n.Scalar())));
         break;
       case KeyType::Choice:
         if (!n.IsScalar() || std::find(k.choices.begin(), k.choices.end(), n.Scalar()) == k.choices.end())

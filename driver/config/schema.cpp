@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <sstream>
 
 namespace mill::config {
@@ -43,6 +44,47 @@ KeyDef choice(std::string path, std::string def, std::vector<std::string> choice
 KeyDef opt(KeyDef k) {
   k.optional = true;
   return k;
+}
+KeyDef matching(KeyDef k, std::string pattern, std::string text) {
+  k.pattern = std::move(pattern);
+  k.pattern_text = std::move(text);
+  return k;
+}
+
+// Slurm resources of a stage's jobs on a cluster (`orchestrate hpc`): the
+// values go into #SBATCH lines, so each is checked against Slurm's syntax.
+const char* kSlurmTime = R"(\d+(:[0-5]\d){0,2}|\d+-\d{1,2}(:[0-5]\d){0,2})";
+const char* kSlurmTimeText = "a Slurm wall time: MINUTES, MM:SS, HH:MM:SS or DAYS-HH[:MM[:SS]] (e.g. 02:00:00)";
+const char* kSlurmMem = "[1-9][0-9]{0,8}[KMGT]?";
+const char* kSlurmMemText = "a memory size: a whole number above 0, optional unit K, M, G or T (e.g. 4G; no unit: MB)";
+const char* kSlurmName = "[A-Za-z0-9_.-]+(,[A-Za-z0-9_.-]+)*";
+const char* kSlurmNameText = "a Slurm partition name (letters, digits, '_', '.', '-'; a comma between several)";
+
+// The resources.<stage>.* keys of one stage (`orchestrate hpc`); `job` names
+// one of its Slurm jobs in the docs. `np_default` "" = no ranks key (a stage
+// without MPI), "-" = optional (the code falls back to --np or resources.np).
+std::vector<KeyDef> stage_resources(const std::string& stage, const std::string& time, const std::string& np_default,
+                                    const std::string& job) {
+  const std::string p = "resources." + stage + ".";
+  std::vector<KeyDef> v;
+  if (np_default == "-")
+    v.push_back(opt(at_least(
+        key(p + "np", KeyType::Int, "", "", "Cluster: MPI ranks per " + job + "; default: --np, else resources.np"), 1)));
+  else if (!np_default.empty())
+    v.push_back(at_least(key(p + "np", KeyType::Int, "", np_default,
+                             "Cluster: MPI ranks per " + job + " (--np overrides when the stage is scripted alone)"),
+                         1));
+  v.push_back(matching(
+      key(p + "time", KeyType::String, "", time, "Cluster: wall-time limit of each " + job + " (--time overrides)"),
+      kSlurmTime, kSlurmTimeText));
+  v.push_back(opt(matching(key(p + "mem", KeyType::String, "", "",
+                               "Cluster: memory of each " + job + " (--mem overrides); default: the partition's"),
+                           kSlurmMem, kSlurmMemText)));
+  v.push_back(opt(matching(key(p + "partition", KeyType::String, "", "",
+                               "Cluster: Slurm partition of the " + stage +
+                                   " jobs (--partition overrides); default: the cluster's"),
+                           kSlurmName, kSlurmNameText)));
+  return v;
 }
 
 using T = KeyType;
@@ -155,7 +197,19 @@ Schema make_case_schema() {
       // --- resources ---
       at_least(key("resources.np", T::Int, "", "1", "MPI ranks per engine run (--np overrides)"), 1),
       at_least(key("resources.jobs", T::Int, "", "1", "Engine runs at once on this machine (--jobs overrides)"), 1),
+      matching(key("resources.merge.time", T::String, "", "00:20:00",
+                   "Cluster: wall-time limit of the small jobs between stages (merges, planning)"),
+               kSlurmTime, kSlurmTimeText),
   };
+  // Per stage on a cluster: the flow wants ranks, breakage many one-rank tasks.
+  for (const auto& [stage, time, np, what] :
+       std::vector<std::array<std::string, 4>>{{"flow", "04:00:00", "-", "flow task (one per rotor speed)"},
+                                               {"sample", "00:30:00", "", "sample job"},
+                                               {"transport", "02:00:00", "1", "transport task (one per rotor speed)"},
+                                               {"calibrate", "02:00:00", "1", "calibration job"},
+                                               {"breakage", "01:00:00", "1", "breakage task (one per impact condition)"},
+                                               {"report", "00:30:00", "", "report job"}})
+    for (auto& k : stage_resources(stage, time, np, what)) s.keys.push_back(std::move(k));
   return s;
 }
 
@@ -224,6 +278,7 @@ std::string type_name(KeyType t) {
 }
 
 std::string expected_text(const KeyDef& k) {
+  if (!k.pattern_text.empty()) return k.pattern_text;
   if (k.type == KeyType::Choice) {
     std::string s = "one of ";
     for (size_t i = 0; i < k.choices.size(); ++i) s += (i ? ", " : "") + k.choices[i];

@@ -25,6 +25,8 @@ struct KeyDef {
   bool max_exclusive = false;
   std::vector<std::string> choices;  // for KeyType::Choice
   bool optional = false;             // may be absent with no default
+  std::string pattern;               // String: ECMAScript regex the whole value must match
+  std::string pattern_text;          // String: what the pattern admits, for messages and docs
 };
 
 // What a table describes: used in messages ("case file", "ore card").

@@ -142,6 +142,8 @@ Status JobStore::read_status(const std::string& label) const {
       else if (k == "start_ticks") s.start_ticks = std::stoull(v);
       else if (k == "reason") s.reason = v;
       else if (k == "time") s.time = v;
+      else if (k == "scheduler_job") s.scheduler_job = v;
+      else if (k == "log") s.log = v;
     } catch (const std::exception&) {
       // A damaged STATUS never reads as done: the job is run again.
       s.state = State::Failed;
@@ -156,12 +158,16 @@ void JobStore::write_status(const std::string& label, const Status& s) const {
   text += "id=" + s.id + "\n";
   if (s.state == State::Running)
     text += fmt::format("pid={}\nhost={}\nstart_ticks={}\n", s.pid, s.host, s.start_ticks);
-  if (!s.reason.empty()) {
-    std::string r = s.reason;
-    for (auto& c : r)
-      if (c == '\n') c = ' ';
-    text += "reason=" + r + "\n";
-  }
+  // One line each: a newline in a value would start a new key.
+  auto line = [&](const char* key, std::string v) {
+    if (v.empty()) return;
+    for (auto& c : v)
+      if (c == '\n' || c == '\r') c = ' ';
+    text += std::string(key) + "=" + v + "\n";
+  };
+  line("reason", s.reason);
+  line("scheduler_job", s.scheduler_job);
+  line("log", s.log);
   text += "time=" + utc_now() + "\n";
   atomic_write(job_dir(label) / "STATUS", text);
 }
@@ -185,7 +191,8 @@ Verdict JobStore::decide(const std::string& label, const nlohmann::json& inputs,
   return {Decision::Run, "pending"};
 }
 
-void JobStore::mark_running(const std::string& label, const nlohmann::json& inputs) const {
+void JobStore::mark_running(const std::string& label, const nlohmann::json& inputs, const std::string& scheduler_job,
+                            const std::string& log) const {
   fs::create_directories(job_dir(label));
   nlohmann::json j = {{"label", label}, {"id", job_id(inputs)}, {"inputs", inputs}};
   atomic_write(job_dir(label) / "job.json", j.dump(2) + "\n");
@@ -195,6 +202,8 @@ void JobStore::mark_running(const std::string& label, const nlohmann::json& inpu
   s.pid = getpid();
   s.host = hostname();
   s.start_ticks = process_start_ticks(s.pid);
+  s.scheduler_job = scheduler_job;
+  s.log = log;
   write_status(label, s);
 }
 

@@ -1,6 +1,7 @@
 // Hash-keyed jobs with a STATUS file each, written by write-then-rename.
 // A job folder holds job.json (label, id, inputs) and STATUS:
-//   pending | running (pid, host, process start) | done | failed (reason).
+//   pending | running (pid, host, process start) | done | failed (reason),
+//   with the scheduler job and its log when a scheduler ran it.
 // A rerun skips done jobs whose id matches, reruns failed and stale-running
 // jobs and jobs whose inputs changed. Success is never inferred from a log.
 #pragma once
@@ -25,6 +26,8 @@ struct Status {
   unsigned long long start_ticks = 0;  // running: process start (from /proc), guards pid reuse
   std::string reason;  // failed: why
   std::string time;    // UTC time of the change
+  std::string scheduler_job;  // the scheduler job that ran it (e.g. Slurm "1234_5"), if any
+  std::string log;            // that scheduler job's output file, if any
 };
 
 // What to do with a job on this run.
@@ -54,8 +57,10 @@ class JobStore {
   // Decide whether to run a job whose canonical inputs are `inputs`.
   Verdict decide(const std::string& label, const nlohmann::json& inputs, bool force) const;
 
-  // Create the folder, write job.json and STATUS=running (this process).
-  void mark_running(const std::string& label, const nlohmann::json& inputs) const;
+  // Create the folder, write job.json and STATUS=running (this process, and
+  // the scheduler job and log it runs in, when given; they stay in STATUS).
+  void mark_running(const std::string& label, const nlohmann::json& inputs, const std::string& scheduler_job = "",
+                    const std::string& log = "") const;
   void mark_done(const std::string& label) const;
   void mark_failed(const std::string& label, const std::string& reason) const;
 

@@ -166,6 +166,16 @@ std::string BreakageStage::damaged_outputs(const StageContext& ctx, const JobSpe
   return damaged_impact_outputs(jobs::JobStore(ctx.stage_dir).job_dir(job.label));
 }
 
+std::vector<std::string> BreakageStage::reads(const config::CaseConfig& cfg) const {
+  if (cfg.doc.str("breakage.conditions") == "transport") return {"transport", "calibrate"};
+  return {"calibrate"};
+}
+
+std::vector<std::string> BreakageStage::jobs_from(const config::CaseConfig& cfg) const {
+  if (cfg.doc.str("breakage.conditions") == "transport") return {"transport"};
+  return {};
+}
+
 Plan BreakageStage::plan(const StageContext& ctx) const {
   Plan p;
   const auto& d = ctx.cfg.doc;

@@ -18,6 +18,10 @@ class BreakageStage : public Stage {
   void run_job(StageContext& ctx, const JobSpec& job, const std::filesystem::path& job_dir) override;
   void finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) override;
   std::string damaged_outputs(const StageContext& ctx, const JobSpec& job) const override;
+  // The calibrated bonds; with breakage.conditions = transport also the
+  // transport's impacts, which decide the jobs (one per binned condition).
+  std::vector<std::string> reads(const config::CaseConfig& cfg) const override;
+  std::vector<std::string> jobs_from(const config::CaseConfig& cfg) const override;
 
  private:
   // breakage/product.csv and product.json: the mill product per rotor speed

@@ -11,6 +11,9 @@ class ReportStage : public Stage {
   std::string name() const override { return "report"; }
   std::string description() const override { return "the HTML report and headline numbers"; }
   Plan plan(const StageContext& ctx) const override;
+  std::vector<std::string> reads(const config::CaseConfig&) const override {
+    return {"flow", "sample", "transport", "calibrate", "breakage"};
+  }
   void run_job(StageContext& ctx, const JobSpec& job, const std::filesystem::path& job_dir) override;
   std::string damaged_outputs(const StageContext& ctx, const JobSpec& job) const override;
 };

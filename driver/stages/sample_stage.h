@@ -24,6 +24,7 @@ class SampleStage : public Stage {
     return "resample the gas velocity on a uniform grid (field.h5, field.vti)";
   }
   Plan plan(const StageContext& ctx) const override;
+  std::vector<std::string> reads(const config::CaseConfig&) const override { return {"flow"}; }
   void run_job(StageContext& ctx, const JobSpec& job,
                const std::filesystem::path& job_dir) override;
   std::string damaged_outputs(const StageContext& ctx, const JobSpec& job) const override;

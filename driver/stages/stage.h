@@ -28,6 +28,10 @@ struct RunOptions {
   int np = 1;                    // MPI ranks per engine run
   int jobs = 1;                  // engine runs at once
   bool force = false;            // redo done jobs
+  // Set when running under a scheduler (the Slurm scripts of `orchestrate hpc`
+  // export MILL_SCHEDULER_JOB and MILL_SCHEDULER_LOG): kept in each job's STATUS.
+  std::string scheduler_job;  // e.g. "1234_5" (array job 1234, task 5)
+  std::string scheduler_log;  // that scheduler job's output file
 };
 
 // One unit of work: the unit of an HPC job-array task.
@@ -79,6 +83,11 @@ class Stage {
   // A job is done only if its declared outputs exist and parse: "" when they
   // do, else what is missing or damaged (the job is then run again).
   virtual std::string damaged_outputs(const StageContext& /*ctx*/, const JobSpec& /*job*/) const { return ""; }
+  // Earlier stages whose declared outputs this stage reads (what a scheduler
+  // chain makes it wait for), and those of them whose outputs decide how many
+  // jobs it has (its plan can only be made once they have run).
+  virtual std::vector<std::string> reads(const config::CaseConfig& /*cfg*/) const { return {}; }
+  virtual std::vector<std::string> jobs_from(const config::CaseConfig& /*cfg*/) const { return {}; }
 };
 
 // The stages in pipeline order: flow, sample, transport, calibrate, breakage, report.

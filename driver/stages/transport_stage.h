@@ -15,6 +15,7 @@ class TransportStage : public Stage {
     return "track ore lumps through the sampled flow (LIGGGHTS, one-way coupled)";
   }
   Plan plan(const StageContext& ctx) const override;
+  std::vector<std::string> reads(const config::CaseConfig&) const override { return {"sample"}; }
   void run_job(StageContext& ctx, const JobSpec& job,
                const std::filesystem::path& job_dir) override;
   std::string damaged_outputs(const StageContext& ctx, const JobSpec& job) const override;

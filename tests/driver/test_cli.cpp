@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "jobs/job_store.h"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -143,6 +145,44 @@ TEST(Cli, HpcWritesArrayAndMergeScripts) {
   std::ifstream s(out / "hpc" / "submit_breakage.sh");
   const std::string submit((std::istreambuf_iterator<char>(s)), std::istreambuf_iterator<char>());
   EXPECT_NE(submit.find("--dependency=afterok"), std::string::npos);
+}
+
+TEST(Cli, HpcStageAllWritesTheChainWithAPlannedBreakage) {
+  const fs::path out = fs::temp_directory_path() / ("mill_cli_hpc_all_" + std::to_string(getpid()));
+  fs::remove_all(out);
+  auto o = orchestrate("hpc --scheduler slurm --stage all --case " + kData + "/tiny_hpc.yaml --output " + out.string());
+  ASSERT_EQ(o.status, 0) << o.text;
+  EXPECT_NE(o.text.find("array sized by a planning job"), std::string::npos) << o.text;
+  EXPECT_NE(o.text.find("submit with: sh " + (out / "hpc" / "submit_all.sh").string()), std::string::npos) << o.text;
+  EXPECT_TRUE(fs::exists(out / "hpc" / "breakage.plan.sh"));
+  // A range is named by what was given.
+  o = orchestrate("hpc --stage flow-transport --case " + kData + "/tiny_hpc.yaml --output " + out.string());
+  ASSERT_EQ(o.status, 0) << o.text;
+  EXPECT_TRUE(fs::exists(out / "hpc" / "submit_flow-transport.sh"));
+  o = orchestrate("hpc --stage report-flow --case " + kData + "/tiny_hpc.yaml --output " + out.string());
+  EXPECT_EQ(o.status, 2) << o.text;
+}
+
+TEST(Cli, MergeOnlyNamesTheJobsNotDoneWithTheirSchedulerJob) {
+  const fs::path out = fs::temp_directory_path() / ("mill_cli_merge_" + std::to_string(getpid()));
+  fs::remove_all(out);
+  const std::string args = "--case " + kData + "/good_small.yaml --output " + out.string() + " --stage breakage";
+  // Task 0 failed under a scheduler; the others never started.
+  const std::string list = orchestrate(args + " --list-tasks").text;
+  const std::string label = list.substr(2, list.find('\t', 2) - 2);
+  const mill::jobs::JobStore store(out / "breakage");
+  store.mark_running(label, {{"x", 1}}, "77_0", "/logs/mill-good_small-breakage_77_0.out");
+  store.mark_failed(label, "liggghts-mill exited with status 1");
+  auto o = orchestrate(args + " --merge-only");
+  EXPECT_EQ(o.status, 1) << o.text;
+  EXPECT_NE(o.text.find("breakage/" + label + " (task 0): failed: liggghts-mill exited with status 1; scheduler job "
+                        "77_0, log /logs/mill-good_small-breakage_77_0.out"),
+            std::string::npos)
+      << o.text;
+  EXPECT_NE(o.text.find("(task 1): not run"), std::string::npos) << o.text;
+  EXPECT_NE(o.text.find("4 of 4 job(s) not done; nothing merged"), std::string::npos) << o.text;
+  EXPECT_FALSE(fs::exists(out / "breakage" / "summary.csv"));
+  EXPECT_EQ(orchestrate(args + " --merge-only --task 0").status, 2);
 }
 
 TEST(Cli, HpcRejectsUnknownScheduler) {

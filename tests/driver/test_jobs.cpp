@@ -31,6 +31,20 @@ TEST(JobId, DependsOnInputsOnlyCanonically) {
   EXPECT_EQ(job_id(a).size(), 16u);
 }
 
+TEST(JobStore, SchedulerJobAndLogStayInStatus) {
+  JobStore s(fresh_dir("sched"));
+  s.mark_running("j", kIn, "1234_5", "/runs/x/hpc/logs/mill-x-breakage_1234_5.out");
+  s.mark_failed("j", "liggghts-mill exited with status 1");
+  const Status st = s.read_status("j");
+  EXPECT_EQ(st.state, State::Failed);
+  EXPECT_EQ(st.scheduler_job, "1234_5");
+  EXPECT_EQ(st.log, "/runs/x/hpc/logs/mill-x-breakage_1234_5.out");
+  // A local rerun (no scheduler) clears them.
+  s.mark_running("j", kIn);
+  EXPECT_TRUE(s.read_status("j").scheduler_job.empty());
+  EXPECT_TRUE(s.read_status("j").log.empty());
+}
+
 TEST(JobStore, NewThenDoneIsSkipped) {
   JobStore s(fresh_dir("done"));
   EXPECT_EQ(s.decide("j", kIn, false).decision, Decision::Run);

@@ -60,6 +60,9 @@ start() {
 
   host=$(hostname -s)
   user=$(id -un)
+  # RealMemory below the machine's, so that jobs may ask for --mem (slurmd
+  # drains a node that has less memory than configured).
+  mem_mb=$(awk '/^MemTotal:/ { print int($2 / 1024 * 0.8) }' /proc/meminfo)
   ctld_port=$(free_port)
   d_port=$(free_port)
   cat > "$dir/slurm.conf" <<CONF
@@ -89,7 +92,7 @@ MinJobAge=600
 JobCompType=jobcomp/none
 JobAcctGatherType=jobacct_gather/none
 AccountingStorageType=accounting_storage/none
-NodeName=$host NodeAddr=127.0.0.1 CPUs=$(nproc) State=UNKNOWN
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$(nproc) RealMemory=$mem_mb State=UNKNOWN
 PartitionName=test Nodes=$host Default=YES MaxTime=INFINITE State=UP
 CONF
   export SLURM_CONF="$dir/slurm.conf"

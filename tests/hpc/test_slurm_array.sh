@@ -1,8 +1,9 @@
 #!/bin/sh
 # Real Slurm test (issue 8): a one-node cluster on localhost runs the job-array
-# scripts that `orchestrate hpc` writes for a three-impact breakage campaign,
-# then the dependent merge job; checks every array task and the merge job
-# completed with exit 0 and the merged summary has one row per impact.
+# scripts that `orchestrate hpc --stage breakage-report` writes for a
+# three-impact breakage campaign, then the dependent merge job and the report
+# job; checks every array task, the merge and the report job completed with
+# exit 0 and the merged summary has one row per impact.
 #
 #   tests/hpc/test_slurm_array.sh ORCHESTRATE CASE_YAML WORKDIR
 #
@@ -25,15 +26,16 @@ trap '"$here/slurm_cluster.sh" stop "$cluster"' EXIT INT TERM
 export SLURM_CONF="$cluster/slurm.conf"
 PATH="$PATH:/usr/sbin"
 
-"$orch" --case "$case_file" --output "$run" --stage breakage --np 1 hpc --scheduler slurm --time 00:10:00
+"$orch" --case "$case_file" --output "$run" --stage breakage-report --np 1 hpc --scheduler slurm --time 00:10:00
 n=$("$orch" --case "$case_file" --output "$run" --stage breakage --list-tasks | wc -l)
 [ "$n" -eq 3 ] || fail "expected 3 tasks from --list-tasks, got $n"
 
-out=$(sh "$run/hpc/submit_breakage.sh")
+out=$(sh "$run/hpc/submit_breakage-report.sh")
 echo "$out"
-array=$(echo "$out" | sed -n 's/^submitted array job \([0-9]*\).* merge job \([0-9]*\).*/\1/p')
-merge=$(echo "$out" | sed -n 's/^submitted array job \([0-9]*\).* merge job \([0-9]*\).*/\2/p')
-[ -n "$array" ] && [ -n "$merge" ] || fail "could not read the job ids from: $out"
+array=$(echo "$out" | sed -n 's/^breakage: array job \([0-9]*\) (3 tasks), merge job \([0-9]*\)$/\1/p')
+merge=$(echo "$out" | sed -n 's/^breakage: array job \([0-9]*\) (3 tasks), merge job \([0-9]*\)$/\2/p')
+report=$(echo "$out" | sed -n 's/^report: job \([0-9]*\)$/\1/p')
+[ -n "$array" ] && [ -n "$merge" ] && [ -n "$report" ] || fail "could not read the job ids from: $out"
 
 # Wait for the queue to drain (at most 10 min), printing it now and then.
 t=0
@@ -61,8 +63,13 @@ e=$(state_of "$merge" ExitCode)
 echo "merge job: $s exit $e"
 [ "$s" = COMPLETED ] && [ "$e" = 0:0 ] || { cat "$run"/hpc/logs/*merge*.out >&2 || true; fail "merge job ended $s with exit $e"; }
 
-# The merge found every job done: it ran no impact itself.
-grep -q "0 run, 3 skipped" "$run"/hpc/logs/*merge_"$merge".out ||
+s=$(state_of "$report" JobState)
+e=$(state_of "$report" ExitCode)
+echo "report job: $s exit $e"
+[ "$s" = COMPLETED ] && [ "$e" = 0:0 ] || { cat "$run"/hpc/logs/*report*.out >&2 || true; fail "report job ended $s with exit $e"; }
+
+# The merge found every job done (it runs none itself: --merge-only).
+grep -q "stage 'breakage': all 3 job(s) done; merged." "$run"/hpc/logs/*merge_"$merge".out ||
   fail "merge job did not find the three impacts done: $(cat "$run"/hpc/logs/*merge_"$merge".out)"
 
 rows=$(($(wc -l <"$run/breakage/summary.csv") - 1))
@@ -71,5 +78,5 @@ for v in 1 20 150; do
   grep -q "^$v,90,0," "$run/breakage/summary.csv" || fail "no row for $v m/s in the merged summary"
 done
 [ -s "$run/breakage/breakage.h5" ] || fail "no merged breakage.h5"
-[ -s "$run/report/index.html" ] || fail "the merge job wrote no report"
-echo "PASS: 3 array tasks and the merge job completed; summary.csv has 3 rows"
+[ -s "$run/report/index.html" ] || fail "the report job wrote no report"
+echo "PASS: 3 array tasks, the merge and the report job completed; summary.csv has 3 rows"
