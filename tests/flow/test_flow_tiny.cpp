@@ -313,7 +313,7 @@ TEST(FlowTiny, CoarseSamplingSpacingNamesTheKey) {
     FAIL() << "expected a spacing error";
   } catch (const config::ConfigError& e) {
     const std::string m = e.what();
-    for (const char* s : {".yaml:20: sample.spacing", "half the narrowest housing side (0.25 m of 0.5 m)", "got 0.4 m"})
+    for (const char* s : {".yaml:21: sample.spacing", "half the narrowest housing side (0.25 m of 0.5 m)", "got 0.4 m"})
       EXPECT_NE(m.find(s), std::string::npos) << s << " not in: " << m;
   }
   fs::remove(yaml);
