@@ -63,7 +63,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_ore_nu.yaml", {"bad_ore_nu_card.yaml:4:", "poisson_ratio", "0.5", "[0, 0.5)"}},
         BadCase{"bad_ore_negative_E.yaml", {"bad_ore_negative_E_card.yaml:3:", "youngs_modulus", "-10.0e9", "> 0 Pa"}},
         BadCase{"bad_ore_missing_key.yaml", {"bad_ore_missing_key_card.yaml", "ucs", "required key is missing"}},
-        BadCase{"bad_ore_moment_factor.yaml", {"bad_ore_moment_factor_card.yaml:8:", "calibrated.bond_moment_factor", "1.5", "[0, 1]"}}),
+        BadCase{"bad_ore_moment_factor.yaml", {"bad_ore_moment_factor_card.yaml:8:", "calibrated.bond_moment_factor", "1.5", "[0, 1]"}},
+        BadCase{"bad_ore_jk_A.yaml", {"bad_ore_jk_A_card.yaml:8:", "jk.A", "120", "(0, 100] %"}},
+        BadCase{"bad_ore_jk_pair.yaml", {"bad_ore_jk_pair_card.yaml:8:", "jk.b", "without jk.A"}}),
     [](const auto& info) {
       std::string n = info.param.file;
       n = n.substr(0, n.find('.'));
