@@ -13,54 +13,18 @@
 #include "jobs/job_store.h"
 #include "postprocess/breakage_results.h"
 #include "progress.h"
+#include "report/headline.h"
+#include "report/html.h"
 
 namespace mill {
 namespace fs = std::filesystem;
 
 namespace {
 
-std::string slurp(const fs::path& f) {
-  std::ifstream in(f, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
-std::string base64(const std::string& in) {
-  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  size_t i = 0;
-  for (; i + 2 < in.size(); i += 3) {
-    const unsigned n = (static_cast<unsigned char>(in[i]) << 16) | (static_cast<unsigned char>(in[i + 1]) << 8) |
-                       static_cast<unsigned char>(in[i + 2]);
-    out += {t[n >> 18], t[(n >> 12) & 63], t[(n >> 6) & 63], t[n & 63]};
-  }
-  if (i + 1 == in.size()) {
-    const unsigned n = static_cast<unsigned char>(in[i]) << 16;
-    out += {t[n >> 18], t[(n >> 12) & 63], '=', '='};
-  } else if (i + 2 == in.size()) {
-    const unsigned n = (static_cast<unsigned char>(in[i]) << 16) | (static_cast<unsigned char>(in[i + 1]) << 8);
-    out += {t[n >> 18], t[(n >> 12) & 63], t[(n >> 6) & 63], '='};
-  }
-  return out;
-}
-
-std::string esc(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else if (c == '"') o += "&quot;";
-    else o += c;
-  }
-  return o;
-}
-
-std::string fmt_value(const nlohmann::json& v) {
-  if (v.is_number_float()) return fmt::format("{:.4g}", v.get<double>());
-  if (v.is_string()) return esc(v.get<std::string>());
-  if (v.is_null()) return "-";
-  return esc(v.dump());
-}
+using report::embed_png;
+using report::esc;
+using report::fold;
+using report::json_table;
 
 // Every file the report reads, under the stage folders it knows.
 std::vector<fs::path> report_inputs(const fs::path& run) {
@@ -84,90 +48,65 @@ std::vector<fs::path> report_inputs(const fs::path& run) {
   return files;
 }
 
-// A JSON object as a two-column table (nested objects flattened with dots).
-void json_table(std::ostringstream& o, const nlohmann::json& j, const std::string& prefix = "") {
-  if (prefix.empty()) o << "<table>\n";
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
-    if (it->is_object()) json_table(o, *it, key);
-    else o << "<tr><td>" << esc(key) << "</td><td>" << fmt_value(*it) << "</td></tr>\n";
-  }
-  if (prefix.empty()) o << "</table>\n";
+// The stage's figures first in the order an engineer reads them, then the rest.
+int figure_rank(const fs::path& f) {
+  static const std::vector<std::string> first = {"jk_t10_vs_ecs.png", "passing_vs_size.png", "product_vs_rpm.png",
+                                                 "largest_vs_velocity.png", "pieces_vs_velocity.png"};
+  const auto it = std::find(first.begin(), first.end(), f.filename().string());
+  return it == first.end() ? static_cast<int>(first.size()) : static_cast<int>(it - first.begin());
 }
 
-// A JSON file, or null when it does not exist or does not parse.
-nlohmann::json read_json(const fs::path& f) {
-  if (!fs::exists(f)) return nullptr;
-  try {
-    return nlohmann::json::parse(slurp(f));
-  } catch (const std::exception&) {
-    return nullptr;
+// The headline rows of the stage's groups as a labelled list (dt/dd).
+void stage_numbers(std::ostringstream& o, const std::vector<report::HeadlineRow>& rows, const std::string& stage) {
+  std::string items;
+  for (const auto& g : report::headline_groups()) {
+    if (g.stage != stage) continue;
+    for (const auto& r : rows)
+      if (r.group == g.title) items += "<dt>" + esc(r.what) + "</dt><dd>" + esc(r.value) + "</dd>\n";
   }
+  if (!items.empty()) o << "<dl class=numbers>\n" << items << "</dl>\n";
 }
 
-// v[key] or null.
-nlohmann::json pick(const nlohmann::json& v, const char* key) {
-  return v.is_object() && v.contains(key) ? v.at(key) : nlohmann::json(nullptr);
+// The ore card's properties in words and units.
+void ore_table(std::ostringstream& o, const config::Document& ore) {
+  o << "<table class=headline>\n";
+  auto row = [&](const std::string& what, const std::string& value) {
+    o << "<tr><td>" << esc(what) << "</td><td>" << esc(value) << "</td></tr>\n";
+  };
+  row("ore", ore.str("name"));
+  row("density", fmt::format("{:g} kg/m3", ore.real("density")));
+  row("Young's modulus", fmt::format("{:.3g} GPa", ore.real("youngs_modulus") / 1e9));
+  row("Poisson's ratio", fmt::format("{:g}", ore.real("poisson_ratio")));
+  row("uniaxial compressive strength (UCS)", fmt::format("{:.3g} MPa", ore.real("ucs") / 1e6));
+  row("tensile strength", fmt::format("{:.3g} MPa", ore.real("tensile_strength") / 1e6));
+  if (ore.has("jk.A") && ore.has("jk.b"))
+    row("JK breakage parameters (measured)",
+        fmt::format("A {:g}%, b {:g} t/kWh, A x b {:.3g}", ore.real("jk.A"), ore.real("jk.b"),
+                    ore.real("jk.A") * ore.real("jk.b")));
+  o << "</table>\n";
 }
 
-void embed_png(std::ostringstream& o, const fs::path& f, const std::string& caption) {
-  o << "<figure><img alt=\"" << esc(caption) << "\" src=\"data:image/png;base64," << base64(slurp(f))
-    << "\"><figcaption>" << esc(caption) << "</figcaption></figure>\n";
-}
-
-// The numbers an engineer looks at first, per stage (and per rotor speed).
-nlohmann::json headline(const fs::path& run) {
-  nlohmann::json h = nlohmann::json::object();
-  for (const auto& d : {run / "flow", run / "transport"}) {
-    if (!fs::is_directory(d)) continue;
-    for (const auto& e : fs::directory_iterator(d)) {
-      const std::string rpm = e.path().filename().string();
-      if (!e.is_directory() || rpm.rfind("rpm", 0) != 0) continue;
-      if (d.filename() == "flow") {
-        const auto f = read_json(e.path() / "flow_report.json");
-        if (f.is_null()) continue;
-        h["flow"][rpm] = {{"domain", pick(f, "domain")},
-                          {"cells", pick(f, "cells")},
-                          {"iterations", pick(f, "iterations")},
-                          {"converged", pick(f, "converged")},
-                          {"mass_imbalance_relative", pick(pick(f, "mass_flow_kg_s"), "imbalance_relative")},
-                          {"inlet_mass_flow_kg_s", pick(pick(f, "mass_flow_kg_s"), "inlet_in")},
-                          {"rim_gas_speed_to_tip_speed", pick(pick(f, "rim"), "ratio_speed_to_tip_speed")}};
-      } else {
-        const auto t = read_json(e.path() / "summary.json");
-        if (t.is_null()) continue;
-        h["transport"][rpm] = {{"lumps", pick(t, "n_particles")},
-                               {"flywheel_impacts", pick(t, "n_flywheel_impacts")},
-                               {"wall_impacts", pick(t, "n_wall_impacts")},
-                               {"flywheel_impact_speed_mean_m_s", pick(t, "flywheel_impact_speed_mean_m_s")},
-                               {"flywheel_normal_speed_mean_m_s", pick(t, "flywheel_normal_speed_mean_m_s")},
-                               {"flywheel_angle_mean_deg", pick(t, "flywheel_angle_mean_deg")}};
-      }
-    }
+// P50 and P80 per impact condition, from breakage/size_distributions.json.
+void size_table(std::ostringstream& o, const nlohmann::json& sd) {
+  const auto conds = report::pick(sd, "conditions");
+  if (!conds.is_array() || conds.empty()) return;
+  const auto finest = report::pick(sd, "finest_sieve_mm");
+  auto mm = [&](const nlohmann::json& v) {
+    if (v.is_number()) return fmt::format("{:.3g}", v.get<double>());
+    return finest.is_number() ? fmt::format("&lt; {:.3g}", finest.get<double>()) : std::string("-");
+  };
+  o << "<table><tr><th>impact speed [m/s]</th><th>angle [deg]</th><th>repeats</th><th>P50 [mm]</th><th>P80 [mm]</th>"
+       "<th>P80 over repeats [mm]</th></tr>\n";
+  for (const auto& c : conds) {
+    const auto r = report::pick(c, "p80_mm_over_repeats");
+    o << fmt::format("<tr><td>{:g}</td><td>{:g}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+                     c.value("velocity_m_s", 0.0), c.value("angle_deg", 0.0), c.value("repeats", 0),
+                     mm(report::pick(c, "p50_mm")), mm(report::pick(c, "p80_mm")),
+                     r.is_object() ? fmt::format("{:.3g}-{:.3g}", r.value("min", 0.0), r.value("max", 0.0)) : "-");
   }
-  const auto cal = read_json(run / "calibrate" / "report.json");
-  if (!cal.is_null())
-    h["calibration"] = {{"source", pick(cal, "source")}, {"converged", pick(cal, "converged")},
-                        {"achieved", pick(cal, "achieved")}};
-  const auto crit = read_json(run / "breakage" / "critical_velocity.json");
-  if (crit.is_array()) {
-    for (const auto& c : crit) {
-      const auto angle = pick(c, "angle_deg");
-      h["breakage"]["critical_velocity_m_s"][angle.is_number() ? fmt::format("{:g} deg", angle.get<double>())
-                                                               : std::string("all conditions")] =
-          pick(c, "critical_velocity_m_s");
-    }
-    h["breakage"]["critical_largest_fraction"] = crit.empty() ? nlohmann::json(nullptr) : pick(crit[0], "threshold");
-  }
-  const auto prod = read_json(run / "breakage" / "product.json");
-  if (prod.is_array())
-    for (const auto& p : prod)
-      if (pick(p, "rpm").is_number()) h["product"][fmt::format("rpm{:g}", pick(p, "rpm").get<double>())] = {
-          {"fully_shredded_mass_fraction", pick(p, "fully_shredded_mass_fraction")},
-          {"largest_piece_mass_fraction", pick(p, "largest_piece_mass_fraction")},
-          {"t10_percent", pick(p, "t10_percent")},
-          {"conditions", pick(p, "conditions")}};
-  return h;
+  o << "</table><p class=note>Sizes are d/D x the lump diameter ("
+    << fmt::format("{:g}", report::pick(sd, "lump_diameter_mm").is_number() ? sd["lump_diameter_mm"].get<double>() : 0.0)
+    << " mm); P50 and P80 are interpolated log-linearly between sieves.</p>\n";
 }
 
 }  // namespace
@@ -182,7 +121,7 @@ Plan ReportStage::plan(const StageContext& ctx) const {
     in.push_back({fs::relative(f, ctx.run_dir).string(), static_cast<long long>(st.st_size),
                   static_cast<long long>(st.st_mtime)});
   }
-  p.jobs.push_back({"report", {{"inputs", in}, {"report_version", 2}},
+  p.jobs.push_back({"report", {{"inputs", in}, {"report_version", 3}},
                     "report/index.html and report/summary.json from every stage's outputs"});
   return p;
 }
@@ -190,7 +129,9 @@ Plan ReportStage::plan(const StageContext& ctx) const {
 void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
   const fs::path run = ctx.run_dir, out_dir = ctx.stage_dir;
   const auto inputs = report_inputs(run);
-  nlohmann::json summary = {{"case", ctx.cfg.name}, {"ore", ctx.cfg.ore.str("name")}, {"headline", headline(run)}};
+  nlohmann::json summary = {
+      {"case", ctx.cfg.name}, {"ore", ctx.cfg.ore.str("name")}, {"headline", report::headline_json(run)}};
+  const auto rows = report::headline_rows(summary["headline"]);
 
   // Figures drawn for the report from the flow stage's files: the mill
   // geometry and the solver's convergence (matplotlib, Debian's python3).
@@ -208,24 +149,33 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
     ctx.runner.run(c);
   }
   std::ostringstream o;
-  o << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>Beater mill: " << esc(ctx.cfg.name)
-    << "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
-       "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}"
-       "td:first-child{text-align:left}img{max-width:100%;border:1px solid #eee;margin:0.5em 0}"
-       "h2{border-bottom:2px solid #468;padding-bottom:2px}.note{color:#666}</style></head><body>\n";
+  o << report::page_head("Beater mill: " + ctx.cfg.name);
   o << "<h1>Beater mill: case " << esc(ctx.cfg.name) << "</h1>\n";
   if (ctx.cfg.doc.has("description")) o << "<p>" << esc(ctx.cfg.doc.str("description")) << "</p>\n";
   o << "<p class=note>Case file <code>" << esc(ctx.cfg.file.string()) << "</code>, ore card <code>"
     << esc(ctx.cfg.ore_file.string()) << "</code>. Every figure is embedded; its data file is linked.</p>\n";
 
-  o << "<h2>Headline numbers</h2>\n";
-  if (summary["headline"].empty()) o << "<p class=note>No stage has produced results yet.</p>\n";
-  else json_table(o, summary["headline"]);
+  // The headline: a short table in words and units, grouped by stage.
+  o << "<h2>Headline</h2>\n";
+  if (rows.empty()) {
+    o << "<p class=note>No stage has produced results yet.</p>\n";
+  } else {
+    o << "<table class=headline>\n";
+    std::string group;
+    for (const auto& r : rows) {
+      if (r.group != group) o << "<tr class=group><th colspan=2>" << esc(r.group) << "</th></tr>\n";
+      group = r.group;
+      o << "<tr><td>" << esc(r.what) << "</td><td>" << esc(r.value) << "</td></tr>\n";
+    }
+    o << "</table>\n";
+  }
 
   o << "<h2>Case and ore card</h2>\n";
   if (fs::exists(figures / "mill_geometry.png")) embed_png(o, figures / "mill_geometry.png", "mill geometry (STL)");
+  ore_table(o, ctx.cfg.ore);
+  o << fold("The ore card as written") ;
   json_table(o, ctx.cfg.ore.to_json());
-  o << "<details><summary>All case keys (defaults included)</summary>\n";
+  o << "</details>\n" << fold("All case keys (defaults included)");
   json_table(o, ctx.cfg.doc.to_json());
   o << "</details>\n";
 
@@ -240,6 +190,7 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
     for (const auto& f : inputs)
       if (fs::relative(f, run).begin()->string() == stage) mine.push_back(f);
     o << "<h2>" << esc(title) << "</h2>\n";
+    // Figures first, then the stage's labelled numbers, then the raw data folded.
     if (stage == "flow" && fs::is_directory(figures))
       for (const auto& f : fs::directory_iterator(figures))
         if (f.path().filename().string().rfind("flow_convergence_", 0) == 0)
@@ -249,45 +200,57 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
         << "</code>).</p>\n";
       continue;
     }
+    std::vector<fs::path> pngs;
+    for (const auto& f : mine)
+      if (f.extension() == ".png") pngs.push_back(f);
+    std::stable_sort(pngs.begin(), pngs.end(),
+                     [](const fs::path& a, const fs::path& b) { return figure_rank(a) < figure_rank(b); });
+    for (const auto& f : pngs) embed_png(o, f, fs::relative(f, run).string());
+    stage_numbers(o, rows, stage);
+    if (stage == "breakage") size_table(o, report::read_json(run / "breakage" / "size_distributions.json"));
+
+    std::ostringstream raw;
+    std::string links;
     for (const auto& f : mine) {
       const std::string rel = fs::relative(f, out_dir).string();
       const std::string name = fs::relative(f, run).string();
       if (f.extension() == ".json") {
         nlohmann::json j;
         try {
-          j = nlohmann::json::parse(slurp(f));
+          j = nlohmann::json::parse(report::slurp(f));
         } catch (const std::exception&) {
           continue;
         }
-        o << "<h3>" << esc(name) << "</h3>\n";
-        if (j.is_object()) json_table(o, j);
+        raw << "<h3>" << esc(name) << "</h3>\n";
+        if (j.is_object()) json_table(raw, j);
         else if (j.is_array())
           for (const auto& e : j)
-            if (e.is_object()) json_table(o, e);
+            if (e.is_object()) json_table(raw, e);
         summary[name] = j;
-      } else if (f.extension() == ".png") {
-        embed_png(o, f, name);
+        links += (links.empty() ? "" : ", ") + std::string("<a href=\"") + esc(rel) + "\">" + esc(name) + "</a>";
       } else if (f.extension() == ".csv" || f.extension() == ".md") {
-        o << "<p>Data: <a href=\"" << esc(rel) << "\">" << esc(name) << "</a></p>\n";
+        links += (links.empty() ? "" : ", ") + std::string("<a href=\"") + esc(rel) + "\">" + esc(name) + "</a>";
       }
     }
+    if (!links.empty()) o << "<p class=note>Data: " << links << "</p>\n";
     if (stage == "breakage" && fs::exists(run / "breakage" / "summary.csv")) {
-      const auto rows = post::ReadSummaryCsv((run / "breakage" / "summary.csv").string());
-      o << "<table><tr><th>V [m/s]</th><th>angle [deg]</th><th>repeat</th><th>pieces</th><th>single</th>"
-           "<th>multi</th><th>largest [%]</th><th>single mass [%]</th><th>broken bonds [%]</th><th>E [kWh/t]</th>"
-           "<th>t10 [%]</th></tr>\n";
-      for (const auto& r : rows)
-        o << fmt::format(
+      const auto impacts = post::ReadSummaryCsv((run / "breakage" / "summary.csv").string());
+      raw << "<h3>Every impact</h3><table><tr><th>V [m/s]</th><th>angle [deg]</th><th>repeat</th><th>pieces</th>"
+             "<th>single</th><th>multi</th><th>largest [%]</th><th>single mass [%]</th><th>broken bonds [%]</th>"
+             "<th>Ecs [kWh/t]</th><th>t10 [%]</th></tr>\n";
+      for (const auto& r : impacts)
+        raw << fmt::format(
             "<tr><td>{:g}</td><td>{:g}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.1f}</td>"
             "<td>{:.1f}</td><td>{:.3g}</td><td>{:.1f}{}</td></tr>\n",
             r.velocity_m_s, r.angle_deg, r.repeat, r.n_pieces, r.n_single, r.n_multi, 100 * r.largest_mass_fraction,
             100 * r.single_mass_fraction, 100 * r.broken_bond_fraction, r.specific_energy_kWh_t, r.t10_percent,
             r.t10_resolved ? "" : "*");
-      o << "</table><p class=note>* t10 not resolved: single elements are coarser than a tenth of the lump.</p>\n";
-      summary["breakage_impacts"] = rows.size();
+      raw << "</table><p class=note>* t10 not resolved: single elements are coarser than a tenth of the lump.</p>\n";
+      summary["breakage_impacts"] = impacts.size();
     }
+    if (!raw.str().empty()) o << fold("Raw results: every key of the stage's JSON files") << raw.str() << "</details>\n";
   }
-  o << "<hr><p class=note>Generated by orchestrate " << MILL_VERSION << ".</p></body></html>\n";
+  o << report::page_tail();
   jobs::atomic_write(out_dir / "index.html", o.str());
   jobs::atomic_write(out_dir / "summary.json", summary.dump(2) + "\n");
   ctx.progress.info("[report] " + (out_dir / "index.html").string());
