@@ -64,7 +64,7 @@ void write_jk_fit(StageContext& ctx, const std::vector<post::ImpactSummary>& row
     post::JkFitRecord rec;
     rec.name = pooled ? "all" : fmt::format("a{:g}", angle);
     std::vector<post::JkPoint> used;
-    long coarsest_elements = 0;
+    long lump_elements = 0;
     for (const auto* s : list) {
       const double e = post::SpecificEnergyKWhPerTonne(s->velocity_m_s);
       rec.ecs_kwh_t.push_back(e);
@@ -72,7 +72,7 @@ void write_jk_fit(StageContext& ctx, const std::vector<post::ImpactSummary>& row
       rec.repeat.push_back(s->repeat);
       rec.used.push_back(s->t10_resolved ? 1 : 0);
       if (s->t10_resolved) used.push_back({e, s->t10_percent, s->repeat});
-      coarsest_elements = std::max(coarsest_elements, static_cast<long>(s->n_elements));
+      lump_elements = std::max(lump_elements, static_cast<long>(s->n_elements));
       csv += fmt::format("{:g},{:g},{},{:.9g},{:.9g},{}\n", s->angle_deg, s->velocity_m_s, s->repeat, e, s->t10_percent,
                          s->t10_resolved ? 1 : 0);
     }
@@ -81,9 +81,9 @@ void write_jk_fit(StageContext& ctx, const std::vector<post::ImpactSummary>& row
     std::string reason = f.reason;
     if (used.empty())
       reason = fmt::format(
-          "t10 is not resolved at any condition: single elements of a {}-element lump are coarser than a tenth of "
-          "the lump (use lump.n_elements of about 1000 or more)",
-          coarsest_elements);
+          "t10 not resolved at any impact (the elements of a {}-element lump are coarser than a tenth of it; "
+          "about 1000 elements or more resolve t10)",
+          lump_elements);
     nlohmann::json e = {
         {"angle_deg", pooled ? nlohmann::json(nullptr) : nlohmann::json(angle)},
         {"relation", "t10 = A (1 - exp(-b Ecs)) (Napier-Munn et al. 1996, Mineral Comminution Circuits, JKMRC)"},
