@@ -155,8 +155,8 @@ json headline_json(const fs::path& run) {
 std::vector<HeadlineRow> headline_rows(const json& h) {
   std::vector<HeadlineRow> rows;
   const auto& groups = headline_groups();
-  auto add = [&](size_t group, std::string what, std::string value) {
-    rows.push_back({groups[group].title, std::move(what), std::move(value)});
+  auto add = [&](size_t group, std::string what, std::string value, bool brief = true) {
+    rows.push_back({groups[group].title, std::move(what), std::move(value), brief});
   };
 
   const json flow = pick(h, "flow");
@@ -167,7 +167,9 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
       add(0, "gas mass flow through the mill" + at,
           fmt::format("{} kg/s", g3(d(f["inlet_mass_flow_kg_s"]))) +
               (num(pick(f, "mass_imbalance_relative"))
-                   ? fmt::format(" (in/out differ by {:.2g}%)", 100 * d(f["mass_imbalance_relative"]))
+                   ? (d(f["mass_imbalance_relative"]) < 1e-4
+                          ? std::string(" (in/out differ by < 0.01%)")
+                          : fmt::format(" (in/out differ by {:.2g}%)", 100 * d(f["mass_imbalance_relative"])))
                    : ""));
     if (num(pick(f, "shaft_power_W")))
       add(0, "flywheel shaft power" + at, fmt::format("{} kW", g3(d(f["shaft_power_W"]) / 1000)));
@@ -176,9 +178,11 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
           fmt::format("{} {} iterations ({} domain, {} cells)",
                       pick(f, "converged") == true ? "converged in" : "not converged after",
                       f["iterations"].get<long>(), pick(f, "domain").is_string() ? f["domain"].get<std::string>() : "?",
-                      num(pick(f, "cells")) ? std::to_string(f["cells"].get<long>()) : "?"));
+                      num(pick(f, "cells")) ? std::to_string(f["cells"].get<long>()) : "?"),
+          false);
     if (num(pick(f, "rim_gas_speed_to_tip_speed")))
-      add(0, "gas speed near the rim" + at, fmt::format("{:.2f} x the tip speed", d(f["rim_gas_speed_to_tip_speed"])));
+      add(0, "gas speed near the rim" + at, fmt::format("{:.2f} x the tip speed", d(f["rim_gas_speed_to_tip_speed"])),
+          false);
   }
 
   const json tr = pick(h, "transport");
@@ -189,7 +193,8 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
       add(1, "lumps and their impacts" + at,
           fmt::format("{} lumps: {} impacts on the flywheel, {} on the walls", t["lumps"].get<long>(),
                       num(pick(t, "flywheel_impacts")) ? t["flywheel_impacts"].get<long>() : 0L,
-                      num(pick(t, "wall_impacts")) ? t["wall_impacts"].get<long>() : 0L));
+                      num(pick(t, "wall_impacts")) ? t["wall_impacts"].get<long>() : 0L),
+          false);
     if (num(pick(t, "flywheel_impact_speed_mean_m_s")))
       add(1, "flywheel impact speed" + at,
           fmt::format("{} m/s{}{}{}", speed(d(t["flywheel_impact_speed_mean_m_s"])),
@@ -214,17 +219,20 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
         const char* what;
         double scale;
         const char* unit;
+        bool brief;
       };
-      for (const P& p : {P{"ucs", "calibrated UCS", 1e-6, "MPa"}, P{"tensile_strength", "calibrated tensile strength", 1e-6, "MPa"},
-                         P{"youngs_modulus", "calibrated Young's modulus", 1e-9, "GPa"},
-                         P{"poisson_ratio", "calibrated Poisson's ratio", 1, ""}}) {
+      for (const P& p : {P{"ucs", "calibrated UCS", 1e-6, "MPa", true},
+                         P{"tensile_strength", "calibrated tensile strength", 1e-6, "MPa", true},
+                         P{"youngs_modulus", "calibrated Young's modulus", 1e-9, "GPa", false},
+                         P{"poisson_ratio", "calibrated Poisson's ratio", 1, "", false}}) {
         const json a = pick(pick(cal, "achieved"), p.key), t = pick(pick(cal, "targets"), p.key);
         if (!num(a)) continue;
         const json ok = pick(pick(cal, "within_tolerance"), p.key);
         add(2, p.what,
             fmt::format("{} of {}{}{}", g3(d(a) * p.scale), num(t) ? g3(d(t) * p.scale) : "?", *p.unit ? " " : "",
                         p.unit) +
-                (ok.is_boolean() ? (ok.get<bool>() ? ": met" : ": not met") : ""));
+                (ok.is_boolean() ? (ok.get<bool>() ? ": met" : ": not met") : ""),
+            p.brief);
       }
     }
   }
@@ -279,10 +287,11 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
     if (p.contains("p80_mm")) add(4, "product P80" + at, size("p80_mm") + " (P50 " + size("p50_mm") + ")");
     if (num(pick(p, "fully_shredded_mass_fraction")))
       add(4, "fully shredded (single elements)" + at, percent(d(p["fully_shredded_mass_fraction"])) + " of the mass");
-    if (num(pick(p, "t10_percent"))) add(4, "t10 (finer than a tenth of the feed)" + at, fmt::format("{:.0f}%", d(p["t10_percent"])));
+    if (num(pick(p, "t10_percent")))
+      add(4, "t10 (finer than a tenth of the feed)" + at, fmt::format("{:.0f}%", d(p["t10_percent"])), false);
     if (num(pick(p, "largest_piece_mass_fraction")))
       add(4, "largest piece" + at,
-          percent(d(p["largest_piece_mass_fraction"])) + " of a lump (mean over the impact conditions)");
+          percent(d(p["largest_piece_mass_fraction"])) + " of a lump (mean over the impact conditions)", false);
   }
   return rows;
 }

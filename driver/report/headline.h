@@ -24,6 +24,7 @@ struct HeadlineRow {
   std::string group;  // e.g. "Breakage of one lump (stage 2)"
   std::string what;   // e.g. "critical impact speed (largest piece < 5%)"
   std::string value;  // e.g. "66 m/s (65-82 over repeats)"
+  bool brief = true;  // in the page's short headline; else only in its stage's section (and in compare)
 };
 
 // The headline in words, grouped by stage in pipeline order.

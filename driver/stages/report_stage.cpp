@@ -163,6 +163,7 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
     o << "<table class=headline>\n";
     std::string group;
     for (const auto& r : rows) {
+      if (!r.brief) continue;  // shown in its stage's section
       if (r.group != group) o << "<tr class=group><th colspan=2>" << esc(r.group) << "</th></tr>\n";
       group = r.group;
       o << "<tr><td>" << esc(r.what) << "</td><td>" << esc(r.value) << "</td></tr>\n";
