@@ -127,7 +127,8 @@ std::optional<double> SizeAtPercentPassing(const std::vector<double>& sieves,
         return std::nullopt;  // finer than the finest sieve
       }
       const double t = (percent - prev_p) / (p - prev_p);
-      return std::exp(std::log(sieves[k - 1]) + t * (std::log(sieves[k]) - std::log(sieves[k - 1])));
+      return std::exp(std::log(sieves[k - 1]) +
+                      t * (std::log(sieves[k]) - std::log(sieves[k - 1])));
     }
     prev_p = p;
   }

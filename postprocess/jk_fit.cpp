@@ -57,7 +57,8 @@ JkFit FitJk(const std::vector<double>& e, const std::vector<double>& t) {
   }
   for (std::size_t i = 0; i < e.size(); ++i) {
     if (!std::isfinite(e[i]) || !std::isfinite(t[i])) {
-      throw PostError(fmt::format("JK fit: point {} is ({}, {}); expected finite numbers", i, e[i], t[i]));
+      throw PostError(
+          fmt::format("JK fit: point {} is ({}, {}); expected finite numbers", i, e[i], t[i]));
     }
   }
   JkFit f;
@@ -67,8 +68,9 @@ JkFit FitJk(const std::vector<double>& e, const std::vector<double>& t) {
     if (x > 0.0) energies.insert(x);
   const double t_max = t.empty() ? 0.0 : *std::max_element(t.begin(), t.end());
   if (e.size() < 3 || energies.size() < 2) {
-    f.reason = fmt::format("{} points at {} distinct energies > 0: need at least 3 points at 2 energies",
-                           e.size(), energies.size());
+    f.reason =
+        fmt::format("{} points at {} distinct energies > 0: need at least 3 points at 2 energies",
+                    e.size(), energies.size());
     return f;
   }
   if (!(t_max > 0.0)) {
@@ -84,14 +86,18 @@ JkFit FitJk(const std::vector<double>& e, const std::vector<double>& t) {
     if (e[i] > 0.0 && t[i] > 0.0 && t[i] < a) b_est.push_back(-std::log(1.0 - t[i] / a) / e[i]);
   double b = 1.0;
   if (!b_est.empty()) {
-    std::nth_element(b_est.begin(), b_est.begin() + static_cast<long>(b_est.size() / 2), b_est.end());
+    std::nth_element(b_est.begin(), b_est.begin() + static_cast<long>(b_est.size() / 2),
+                     b_est.end());
     b = b_est[b_est.size() / 2];
   }
 
   double s = SumSquares(e, t, a, b);
   double lambda = 1e-3;
+  constexpr int kMaxIterations = 500;
   int it = 0;
-  for (; it < 500; ++it) {
+  bool converged = false;
+  while (!converged && it < kMaxIterations) {
+    ++it;
     // Normal equations of the linearised residuals: (J^T J + lambda diag) d = J^T r.
     double jtj[2][2] = {{0, 0}, {0, 0}}, jtr[2] = {0, 0};
     for (std::size_t i = 0; i < e.size(); ++i) {
@@ -103,6 +109,7 @@ JkFit FitJk(const std::vector<double>& e, const std::vector<double>& t) {
         for (int q = 0; q < 2; ++q) jtj[p][q] += g[p] * g[q];
       }
     }
+    // Raise lambda until a step lowers the sum of squares (or give up: at the minimum).
     bool improved = false;
     for (int tries = 0; tries < 30 && !improved; ++tries) {
       const double m00 = jtj[0][0] * (1 + lambda), m11 = jtj[1][1] * (1 + lambda), m01 = jtj[0][1];
@@ -115,22 +122,22 @@ JkFit FitJk(const std::vector<double>& e, const std::vector<double>& t) {
       const double db = (m00 * jtr[1] - m01 * jtr[0]) / det;
       const double a_new = a + da, b_new = b + db;
       const double s_new = (a_new > 0.0 && b_new > 0.0) ? SumSquares(e, t, a_new, b_new) : HUGE_VAL;
-      if (s_new <= s) {
-        const bool small = std::abs(da) <= 1e-12 * (1 + std::abs(a)) && std::abs(db) <= 1e-12 * (1 + std::abs(b));
-        a = a_new;
-        b = b_new;
-        const double drop = s - s_new;
-        s = s_new;
-        lambda = std::max(1e-12, lambda / 10);
-        improved = true;
-        if (small || drop <= 1e-15 * (1 + s)) it = 1000;  // converged
-      } else {
+      if (s_new > s) {
         lambda *= 10;
+        continue;
       }
+      const bool tiny_step =
+          std::abs(da) <= 1e-12 * (1 + std::abs(a)) && std::abs(db) <= 1e-12 * (1 + std::abs(b));
+      converged = tiny_step || s - s_new <= 1e-15 * (1 + s_new);
+      a = a_new;
+      b = b_new;
+      s = s_new;
+      lambda = std::max(1e-12, lambda / 10);
+      improved = true;
     }
-    if (!improved) break;  // no step lowers the sum: at the minimum
+    if (!improved) converged = true;
   }
-  f.iterations = std::min(it, 500);
+  f.iterations = it;
   f.ok = true;
   f.a_percent = a;
   f.b_t_per_kwh = b;
@@ -151,8 +158,9 @@ JkFit FitJk(const std::vector<double>& e, const std::vector<double>& t) {
     f.b_se_t_per_kwh = std::sqrt(s2 * jtj[0][0] / det);
   }
   if (b * *energies.rbegin() < 0.5) {
-    f.note = "the sweep stays on the initial slope (b x largest Ecs < 0.5): A and b are poorly "
-               "separated, A x b is the robust figure";
+    f.note =
+        "the sweep stays on the initial slope (b x largest Ecs < 0.5): A and b are poorly "
+        "separated, A x b is the robust figure";
   }
   return f;
 }

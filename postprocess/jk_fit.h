@@ -25,12 +25,12 @@ double JkT10(double a_percent, double b_t_per_kwh, double ecs_kwh_t);
 // One fit of A and b by least squares.
 struct JkFit {
   bool ok = false;
-  std::string reason;            // why there is no fit (when !ok)
-  std::string note;              // a caveat on a fit that did succeed
-  double a_percent = 0.0;        // A, %
-  double b_t_per_kwh = 0.0;      // b, t/kWh
-  double a_se_percent = 0.0;     // standard error of A from the fit (0 with 2 points)
-  double b_se_t_per_kwh = 0.0;   // standard error of b
+  std::string reason;           // why there is no fit (when !ok)
+  std::string note;             // a caveat on a fit that did succeed
+  double a_percent = 0.0;       // A, %
+  double b_t_per_kwh = 0.0;     // b, t/kWh
+  double a_se_percent = 0.0;    // standard error of A from the fit (0 with 2 points)
+  double b_se_t_per_kwh = 0.0;  // standard error of b
   double rms_residual_percent = 0.0;
   int n_points = 0;
   int iterations = 0;
@@ -62,8 +62,8 @@ struct Spread {
 // and A x b is over the repeats whose fit succeeded (absent when none did).
 struct JkSweepFit {
   JkFit pooled;
-  std::vector<int> repeats;          // repeat ids, ascending
-  std::vector<JkFit> per_repeat;     // same order
+  std::vector<int> repeats;       // repeat ids, ascending
+  std::vector<JkFit> per_repeat;  // same order
   int n_repeats_fitted = 0;
   std::optional<Spread> a_percent, b_t_per_kwh, ab;
 };

@@ -161,51 +161,54 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
 
   const json flow = pick(h, "flow");
   for (const auto& rpm : rpm_keys(flow)) {
-    const json& f = flow[rpm];
+    const json& f = flow.at(rpm);
     const std::string at = ", " + rpm_words(rpm);
     if (num(pick(f, "inlet_mass_flow_kg_s")))
       add(0, "gas mass flow through the mill" + at,
-          fmt::format("{} kg/s", g3(d(f["inlet_mass_flow_kg_s"]))) +
+          fmt::format("{} kg/s", g3(d(f.at("inlet_mass_flow_kg_s")))) +
               (num(pick(f, "mass_imbalance_relative"))
-                   ? (d(f["mass_imbalance_relative"]) < 1e-4
+                   ? (d(f.at("mass_imbalance_relative")) < 1e-4
                           ? std::string(" (in/out differ by < 0.01%)")
-                          : fmt::format(" (in/out differ by {:.2g}%)", 100 * d(f["mass_imbalance_relative"])))
+                          : fmt::format(" (in/out differ by {:.2g}%)", 100 * d(f.at("mass_imbalance_relative"))))
                    : ""));
     if (num(pick(f, "shaft_power_W")))
-      add(0, "flywheel shaft power" + at, fmt::format("{} kW", g3(d(f["shaft_power_W"]) / 1000)));
-    if (num(pick(f, "iterations")))
+      add(0, "flywheel shaft power" + at, fmt::format("{} kW", g3(d(f.at("shaft_power_W")) / 1000)));
+    if (num(pick(f, "iterations"))) {
+      std::string mesh;
+      if (pick(f, "domain").is_string()) mesh = f.at("domain").get<std::string>() + " domain";
+      if (num(pick(f, "cells")))
+        mesh += (mesh.empty() ? "" : ", ") + std::to_string(f.at("cells").get<long>()) + " cells";
       add(0, "flow solution" + at,
-          fmt::format("{} {} iterations ({} domain, {} cells)",
-                      pick(f, "converged") == true ? "converged in" : "not converged after",
-                      f["iterations"].get<long>(), pick(f, "domain").is_string() ? f["domain"].get<std::string>() : "?",
-                      num(pick(f, "cells")) ? std::to_string(f["cells"].get<long>()) : "?"),
+          fmt::format("{} {} iterations{}", pick(f, "converged") == true ? "converged in" : "not converged after",
+                      f.at("iterations").get<long>(), mesh.empty() ? "" : " (" + mesh + ")"),
           false);
+    }
     if (num(pick(f, "rim_gas_speed_to_tip_speed")))
-      add(0, "gas speed near the rim" + at, fmt::format("{:.2f} x the tip speed", d(f["rim_gas_speed_to_tip_speed"])),
+      add(0, "gas speed near the rim" + at, fmt::format("{:.2f} x the tip speed", d(f.at("rim_gas_speed_to_tip_speed"))),
           false);
   }
 
   const json tr = pick(h, "transport");
   for (const auto& rpm : rpm_keys(tr)) {
-    const json& t = tr[rpm];
+    const json& t = tr.at(rpm);
     const std::string at = ", " + rpm_words(rpm);
     if (num(pick(t, "lumps")))
       add(1, "lumps and their impacts" + at,
-          fmt::format("{} lumps: {} impacts on the flywheel, {} on the walls", t["lumps"].get<long>(),
-                      num(pick(t, "flywheel_impacts")) ? t["flywheel_impacts"].get<long>() : 0L,
-                      num(pick(t, "wall_impacts")) ? t["wall_impacts"].get<long>() : 0L),
+          fmt::format("{} lumps: {} impacts on the flywheel, {} on the walls", t.at("lumps").get<long>(),
+                      num(pick(t, "flywheel_impacts")) ? t.at("flywheel_impacts").get<long>() : 0L,
+                      num(pick(t, "wall_impacts")) ? t.at("wall_impacts").get<long>() : 0L),
           false);
     if (num(pick(t, "flywheel_impact_speed_mean_m_s")))
       add(1, "flywheel impact speed" + at,
-          fmt::format("{} m/s{}{}{}", speed(d(t["flywheel_impact_speed_mean_m_s"])),
+          fmt::format("{} m/s{}{}{}", speed(d(t.at("flywheel_impact_speed_mean_m_s"))),
                       num(pick(t, "flywheel_impact_speed_std_m_s"))
-                          ? fmt::format(" ± {} (sd)", speed(d(t["flywheel_impact_speed_std_m_s"])))
+                          ? fmt::format(" ± {} (sd)", speed(d(t.at("flywheel_impact_speed_std_m_s"))))
                           : "",
                       num(pick(t, "flywheel_normal_speed_mean_m_s"))
-                          ? fmt::format(", normal part {} m/s", speed(d(t["flywheel_normal_speed_mean_m_s"])))
+                          ? fmt::format(", normal part {} m/s", speed(d(t.at("flywheel_normal_speed_mean_m_s"))))
                           : "",
                       num(pick(t, "flywheel_angle_mean_deg"))
-                          ? fmt::format(", {:.0f} deg to the surface", d(t["flywheel_angle_mean_deg"]))
+                          ? fmt::format(", {:.0f} deg to the surface", d(t.at("flywheel_angle_mean_deg")))
                           : ""));
   }
 
@@ -242,12 +245,12 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
     for (const auto& c : crit) {
       const json thr = pick(c, "largest_fraction_threshold");
       std::string what = "critical impact speed" + (num(thr) ? " (largest piece < " + percent(d(thr)) + ")" : "");
-      if (num(pick(c, "angle_deg"))) what += fmt::format(", {:g} deg", d(c["angle_deg"]));
+      if (num(pick(c, "angle_deg"))) what += fmt::format(", {:g} deg", d(c.at("angle_deg")));
       std::string v = "not reached in the sweep";
       if (num(pick(c, "critical_velocity_m_s"))) {
-        v = speed(d(c["critical_velocity_m_s"])) + " m/s";
-        if (num(pick(c, "min_m_s")) && num(pick(c, "max_m_s")) && d(c["min_m_s"]) < d(c["max_m_s"]))
-          v += fmt::format(" ({}-{} over repeats)", speed(d(c["min_m_s"])), speed(d(c["max_m_s"])));
+        v = speed(d(c.at("critical_velocity_m_s"))) + " m/s";
+        if (num(pick(c, "min_m_s")) && num(pick(c, "max_m_s")) && d(c.at("min_m_s")) < d(c.at("max_m_s")))
+          v += fmt::format(" ({}-{} over repeats)", speed(d(c.at("min_m_s"))), speed(d(c.at("max_m_s"))));
       }
       add(3, what, v);
     }
@@ -256,42 +259,42 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
   if (jk.is_array())
     for (const auto& j : jk) {
       std::string what = "JK breakage parameters";
-      if (num(pick(j, "angle_deg"))) what += fmt::format(", {:g} deg", d(j["angle_deg"]));
+      if (num(pick(j, "angle_deg"))) what += fmt::format(", {:g} deg", d(j.at("angle_deg")));
       if (pick(j, "fitted") == true) {
-        std::string v = fmt::format("A {}%, b {} t/kWh, A x b {}", g3(d(j["A_percent"])), g3(d(j["b_t_per_kWh"])),
-                                    g3(d(j["A_times_b"])));
+        std::string v = fmt::format("A {}%, b {} t/kWh, A x b {}", g3(d(j.at("A_percent"))), g3(d(j.at("b_t_per_kWh"))),
+                                    g3(d(j.at("A_times_b"))));
         const json ab = pick(pick(j, "over_repeats"), "A_times_b");
         const json n = pick(j, "repeats_fitted");
         if (num(n) && n.get<int>() > 1 && num(pick(ab, "min")))
-          v += fmt::format(" (A x b {}-{} over {} repeats)", g3(d(ab["min"])), g3(d(ab["max"])), n.get<int>());
+          v += fmt::format(" (A x b {}-{} over {} repeats)", g3(d(ab.at("min"))), g3(d(ab.at("max"))), n.get<int>());
         add(3, what, v);
       } else {
-        add(3, what, "not fitted: " + (pick(j, "reason").is_string() ? j["reason"].get<std::string>() : std::string("?")));
+        add(3, what, "not fitted: " + (pick(j, "reason").is_string() ? j.at("reason").get<std::string>() : std::string("?")));
       }
-      if (pick(j, "ore_card").is_object()) card = j["ore_card"];
+      if (pick(j, "ore_card").is_object()) card = j.at("ore_card");
     }
   if (card.is_object())
     add(3, "JK breakage parameters measured (ore card)",
-        fmt::format("A {}%, b {} t/kWh, A x b {}", g3(d(card["A_percent"])), g3(d(card["b_t_per_kWh"])),
-                    g3(d(card["A_times_b"]))));
+        fmt::format("A {}%, b {} t/kWh, A x b {}", g3(d(card.at("A_percent"))), g3(d(card.at("b_t_per_kWh"))),
+                    g3(d(card.at("A_times_b")))));
 
   const json prod = pick(h, "product");
   for (const auto& rpm : rpm_keys(prod)) {
-    const json& p = prod[rpm];
+    const json& p = prod.at(rpm);
     const std::string at = ", " + rpm_words(rpm);
     auto size = [&](const char* k) {
       if (num(pick(p, k))) return g3(d(p[k])) + " mm";
-      if (num(pick(p, "finest_sieve_mm"))) return "< " + g3(d(p["finest_sieve_mm"])) + " mm";
+      if (num(pick(p, "finest_sieve_mm"))) return "< " + g3(d(p.at("finest_sieve_mm"))) + " mm";
       return std::string("?");
     };
     if (p.contains("p80_mm")) add(4, "product P80" + at, size("p80_mm") + " (P50 " + size("p50_mm") + ")");
     if (num(pick(p, "fully_shredded_mass_fraction")))
-      add(4, "fully shredded (single elements)" + at, percent(d(p["fully_shredded_mass_fraction"])) + " of the mass");
+      add(4, "fully shredded (single elements)" + at, percent(d(p.at("fully_shredded_mass_fraction"))) + " of the mass");
     if (num(pick(p, "t10_percent")))
-      add(4, "t10 (finer than a tenth of the feed)" + at, fmt::format("{:.0f}%", d(p["t10_percent"])), false);
+      add(4, "t10 (finer than a tenth of the feed)" + at, fmt::format("{:.0f}%", d(p.at("t10_percent"))), false);
     if (num(pick(p, "largest_piece_mass_fraction")))
       add(4, "largest piece" + at,
-          percent(d(p["largest_piece_mass_fraction"])) + " of a lump (mean over the impact conditions)", false);
+          percent(d(p.at("largest_piece_mass_fraction"))) + " of a lump (mean over the impact conditions)", false);
   }
   return rows;
 }

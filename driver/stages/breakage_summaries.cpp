@@ -3,9 +3,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <map>
 
-#include "engine/liggghts.h"
 #include "engine/runner.h"
 #include "jobs/job_store.h"
 #include "postprocess/distributions.h"

@@ -32,7 +32,8 @@ TEST(PlotBreakage, WritesPngsAndCriticalVelocity) {
   const std::string summary = (dir / "summary.csv").string();
   const std::string passing = (dir / "size_distributions.csv").string();
   std::ofstream pass(passing);
-  pass << "velocity_m_s,angle_deg,sieve_mm,passing_percent,passing_percent_min,passing_percent_max\n";
+  pass << "velocity_m_s,angle_deg,sieve_mm,passing_percent,passing_percent_min,passing_percent_"
+          "max\n";
 
   // Two repeats at four speeds; largest piece falls from 1 to 0.01.
   const double speeds[] = {20.0, 60.0, 100.0, 150.0};
@@ -55,8 +56,8 @@ TEST(PlotBreakage, WritesPngsAndCriticalVelocity) {
       points.push_back({speeds[k], rep, largest[rep][k]});
     }
     for (double sieve : {2.0, 4.0, 8.0, 16.0, 40.0})
-      pass << speeds[rep] << ",90," << sieve << "," << 100 * sieve / 40 << "," << 90 * sieve / 40 << ","
-           << 100 * sieve / 40 << "\n";
+      pass << speeds[rep] << ",90," << sieve << "," << 100 * sieve / 40 << "," << 90 * sieve / 40
+           << "," << 100 * sieve / 40 << "\n";
   }
   pass.close();
   const fs::path out = dir / "plots";
@@ -94,8 +95,9 @@ TEST(PlotJk, DrawsPointsFitAndOreCardAndNamesABadFile) {
   std::ofstream(dir / "jk_fit.json")
       << R"([{"angle_deg": 90, "fitted": true, "A_percent": 50, "b_t_per_kWh": 1.1,)"
       << R"( "ore_card": {"A_percent": 55, "b_t_per_kWh": 0.9}}])";
-  const std::string base = kPython + " " + MILL_PLOT_JK_SCRIPT + " --points " + (dir / "jk_points.csv").string() +
-                           " --out " + (dir / "plots").string() + " --fit ";
+  const std::string base = kPython + " " + MILL_PLOT_JK_SCRIPT + " --points " +
+                           (dir / "jk_points.csv").string() + " --out " + (dir / "plots").string() +
+                           " --fit ";
   ASSERT_EQ(std::system((base + (dir / "jk_fit.json").string()).c_str()), 0);
   EXPECT_GT(fs::file_size(dir / "plots" / "jk_t10_vs_ecs.png"), 1000u);
   std::ofstream(dir / "bad.json") << R"([{"angle_deg": 90, "fitted": true}])";
@@ -113,8 +115,7 @@ TEST(PlotBreakage, MissingColumnFailsWithItsName) {
   fs::create_directories(dir);
   std::ofstream(dir / "s.csv") << "velocity_m_s,angle_deg\n1,90\n";
   const std::string cmd = kPython + " " + kScript + " --summary " + (dir / "s.csv").string() +
-                          " --out " +
-                          (dir / "o").string() + " 2> " + (dir / "err.txt").string();
+                          " --out " + (dir / "o").string() + " 2> " + (dir / "err.txt").string();
   EXPECT_NE(std::system(cmd.c_str()), 0);
   std::ifstream err(dir / "err.txt");
   const std::string text((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());
