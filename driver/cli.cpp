@@ -4,9 +4,11 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <regex>
 
 #include "compare.h"
 #include "config/case_config.h"
@@ -46,6 +48,47 @@ Exit status: 0 ok, 1 a job failed, 2 bad input, 3 stage not implemented yet,
 128+N interrupted by signal N.
 )";
 
+// A CLI11 check: a plain decimal number (no hex, inf or nan) in [lo, hi],
+// a whole number when `integer`. The message reads "expected ..., got '...'".
+CLI::Validator decimal(double lo, double hi, bool integer, const std::string& what, bool lo_open = false) {
+  const std::string range = integer ? fmt::format("a whole number in [{}, {}]", static_cast<long long>(lo),
+                                                  static_cast<long long>(hi))
+                                    : fmt::format("{} in {}{:g}, {:g}]", what, lo_open ? "(" : "[", lo, hi);
+  return CLI::Validator(
+      [=](std::string& in) -> std::string {
+        static const std::regex real(R"([+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?)");
+        static const std::regex whole(R"([+-]?[0-9]+)");
+        const bool form = std::regex_match(in, integer ? whole : real);
+        double v = 0;
+        if (form) {
+          errno = 0;
+          v = std::strtod(in.c_str(), nullptr);
+        }
+        if (form && errno == 0 && (lo_open ? v > lo : v >= lo) && v <= hi) return "";
+        return fmt::format("expected {}{}, got '{}'", range, integer ? "" : " (decimal)", in);
+      },
+      integer ? "INT" : "NUMBER");
+}
+
+// The run folder must be a folder, or a path that can become one: no part of
+// it may be an existing regular file.
+void check_output_path(const fs::path& out) {
+  std::error_code ec;
+  for (fs::path p = out; !p.empty(); p = p.parent_path()) {
+    if (fs::exists(p, ec)) {
+      if (fs::is_directory(p, ec)) return;
+      throw config::ConfigError(
+          p == out ? fmt::format("--output {}: is a file; expected a run folder (a directory, or a path that does not "
+                                 "exist yet)",
+                                 out.string())
+                   : fmt::format("--output {}: {} is a file, so the run folder cannot be made below it; expected a "
+                                 "path under a directory",
+                                 out.string(), p.string()));
+    }
+    if (p == p.parent_path()) return;
+  }
+}
+
 }  // namespace
 
 int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
@@ -60,13 +103,14 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
   app.add_option("-c,--case", case_file, "Case file (YAML)")->capture_default_str();
   app.add_option("-s,--stage", stage, "Stage to run: flow, sample, transport, calibrate, breakage, report, all");
   app.add_option("-o,--output", output, "Run folder (default: runs/<case name>)");
-  app.add_option("--np", np, "MPI ranks per engine run (default: resources.np of the case)")->check(CLI::PositiveNumber);
+  app.add_option("--np", np, "MPI ranks per engine run (default: resources.np of the case)")
+      ->check(decimal(1, 100000, true, "ranks"));
   app.add_option("-j,--jobs", jobs, "Engine runs at once on this machine (default: resources.jobs)")
-      ->check(CLI::PositiveNumber);
+      ->check(decimal(1, 1024, true, "jobs"));
   app.add_flag("-n,--dry-run", dry_run, "Print the plan (stages, jobs, which are done); run nothing");
   app.add_flag("--list-tasks", list_tasks, "List the jobs of the stage, one per line: index, label, state, summary");
   app.add_option("--task", task, "Run only job I (0-based) of the stage: one HPC array task")
-      ->check(CLI::NonNegativeNumber);
+      ->check(decimal(0, 10000000, true, "task"));
   app.add_flag("-f,--force", force, "Redo jobs that are already done");
   app.add_flag("--print-schema", print_schema, "Print every case-file and ore-card key as Markdown");
   app.add_flag("--check", check, "Validate the case file and its ore card, then exit");
@@ -78,23 +122,19 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
   int imp_repeat = 0;
   CLI::App* impact = app.add_subcommand(
       "impact", "One lump impact (deck + fragment analysis) into --output; prints its figures");
-  const CLI::Validator positive_speed(
-      [](std::string& in) -> std::string {
-        try {
-          if (std::stod(in) > 0) return "";
-        } catch (const std::exception&) {
-        }
-        return "expected a speed > 0 m/s, got '" + in + "'";
-      },
-      "SPEED>0");
-  impact->add_option("-v,--velocity", imp_velocity, "Impact speed, m/s")->required()->check(positive_speed);
+  // The same bounds as breakage.velocities and breakage.angles in the case schema.
+  const config::KeyDef& vel_key = *config::case_schema().find("breakage.velocities");
+  impact->add_option("-v,--velocity", imp_velocity, "Impact speed, m/s")
+      ->required()
+      ->check(decimal(0, *vel_key.max, false, "a speed in m/s", true));
   impact->add_option("-a,--angle", imp_angle, "Angle to the surface, deg (90 = normal)")
-      ->check(CLI::Range(0.001, 90.0))
+      ->check(decimal(0, 90, false, "an angle in deg", true))
       ->capture_default_str();
   impact->add_option("--ore", imp_ore, "Ore card (file or bundled name, e.g. granite); default: the case's");
   impact->add_option("--elements", imp_elements, "Elements in the lump; default: the case's lump.n_elements")
-      ->check(CLI::Range(2L, 10000000L));
-  impact->add_option("--repeat", imp_repeat, "Repeat index (random orientation)")->check(CLI::NonNegativeNumber);
+      ->check(decimal(2, 10000000, true, "elements"));
+  impact->add_option("--repeat", imp_repeat, "Repeat index (random orientation)")
+      ->check(decimal(0, 1000000, true, "repeat"));
   impact->footer("\nExample:\n  orchestrate impact --velocity 100 --angle 60 --ore granite --elements 400 --output try1\n");
   impact->fallthrough();
 
@@ -106,7 +146,8 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
   hpc->add_option("--account", hpc_opt.account, "Slurm account");
   hpc->add_option("--time", hpc_opt.time, "Wall-time limit per array task (HH:MM:SS)")->capture_default_str();
   hpc->add_option("--mem", hpc_opt.mem, "Memory per task, e.g. 4G");
-  hpc->add_option("--max-parallel", hpc_opt.max_parallel, "At most this many tasks at once (0: no limit)");
+  hpc->add_option("--max-parallel", hpc_opt.max_parallel, "At most this many tasks at once (0: no limit)")
+      ->check(decimal(0, 100000, true, "tasks"));
   hpc->footer("\nExample:\n  orchestrate hpc --scheduler slurm --stage breakage --case cases/reference.yaml --np 1\n"
               "  sh runs/reference/hpc/submit_breakage.sh\n");
   hpc->fallthrough();
@@ -148,6 +189,9 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
                                               : fs::path(output);
       RunOptions opts;
       opts.output = fs::absolute(out_dir);
+      check_output_path(opts.output);
+      check_run_folder(cfg, opts.output, force);
+      opts.force = force;
       opts.np = np > 0 ? np : static_cast<int>(cfg.doc.integer("resources.np"));
       return run_single_impact(cfg, opts, imp_velocity, imp_angle, imp_repeat, out);
     }
@@ -164,7 +208,9 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
       if (stage.empty()) throw config::ConfigError("--stage: hpc needs the stage whose jobs become array tasks");
       resolve_stages(stage);
       hpc_opt.stage = stage;
-      hpc_opt.output = output.empty() ? fs::path("runs") / cfg.name : fs::path(output);
+      hpc_opt.output = fs::absolute(output.empty() ? fs::path("runs") / cfg.name : fs::path(output));
+      check_output_path(hpc_opt.output);
+      check_run_folder(cfg, hpc_opt.output, force);
       hpc_opt.np = np > 0 ? np : static_cast<int>(cfg.doc.integer("resources.np"));
       Invocation inv;
       inv.stages = {stage};
@@ -187,6 +233,8 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
     inv.stages = resolve_stages(stage);
     // Absolute: engines and helper scripts run in other working directories.
     inv.opts.output = fs::absolute(output.empty() ? fs::path("runs") / cfg.name : fs::path(output));
+    check_output_path(inv.opts.output);
+    check_run_folder(cfg, inv.opts.output, force);
     inv.opts.np = np > 0 ? np : static_cast<int>(cfg.doc.integer("resources.np"));
     inv.opts.jobs = jobs > 0 ? jobs : static_cast<int>(cfg.doc.integer("resources.jobs"));
     inv.opts.force = force;
@@ -202,6 +250,12 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
     return kExitNotImplemented;
   } catch (const MissingInput& e) {
     err << "error: " << e.what() << "\n";
+    return kExitFailed;
+  } catch (const fs::filesystem_error& e) {
+    // A file operation the user's paths or disk made fail: name the path.
+    err << "error: " << (e.path1().empty() ? std::string("a file operation") : e.path1().string()) << ": "
+        << e.code().message() << (e.path2().empty() ? "" : " (with " + e.path2().string() + ")")
+        << "\nCheck that the run folder (--output) is a writable directory with free space.\n";
     return kExitFailed;
   } catch (const engine::Interrupted& e) {
     err << "orchestrate: " << e.what() << "; finished jobs are kept, rerun the same command to resume\n";

@@ -4,6 +4,9 @@
 #include <fmt/format.h>
 #include <sys/stat.h>
 
+#include <cctype>
+#include <regex>
+
 #include "jobs/job_store.h"
 
 namespace mill {
@@ -26,10 +29,54 @@ std::string header(const HpcOptions& o, const std::string& name, const fs::path&
   if (!o.partition.empty()) h += fmt::format("#SBATCH --partition={}\n", o.partition);
   if (!o.account.empty()) h += fmt::format("#SBATCH --account={}\n", o.account);
   if (!o.mem.empty()) h += fmt::format("#SBATCH --mem={}\n", o.mem);
-  h += fmt::format("#SBATCH --output={}/{}.out\n", logs.string(), log_pattern);
+  // Quoted: sbatch splits #SBATCH lines on blanks outside quotes.
+  h += fmt::format("#SBATCH --output=\"{}/{}.out\"\n", logs.string(), log_pattern);
   return h;
 }
 }  // namespace
+
+void check_hpc_options(const HpcOptions& o) {
+  auto bad = [](const std::string& opt, const std::string& value, const std::string& expected) {
+    std::string shown;
+    for (char c : value)
+      shown += std::iscntrl(static_cast<unsigned char>(c)) ? fmt::format("\\x{:02x}", static_cast<unsigned char>(c))
+                                                            : std::string(1, c);
+    throw config::ConfigError(fmt::format("{}: expected {}, got '{}'", opt, expected, shown));
+  };
+  // Slurm's --time forms: M, M:S, H:M:S, D-H, D-H:M, D-H:M:S.
+  static const std::regex time_re(R"((\d+)|(\d+):(\d{1,2})|(\d+):(\d{1,2}):(\d{1,2})|(\d+)-(\d{1,2})(:(\d{1,2})(:(\d{1,2}))?)?)");
+  std::smatch m;
+  bool time_ok = std::regex_match(o.time, m, time_re);
+  if (time_ok) {
+    // Minutes and seconds after a larger unit below 60, hours after days below 24; not all zero.
+    const auto num = [&](int i) { return m[i].matched ? std::stol(m[i].str()) : 0L; };
+    if (m[2].matched) time_ok = num(3) < 60;
+    if (m[4].matched) time_ok = num(5) < 60 && num(6) < 60;
+    if (m[7].matched) time_ok = num(8) < 24 && num(10) < 60 && num(12) < 60;
+    time_ok = time_ok && o.time.find_first_not_of("0:-") != std::string::npos;
+  }
+  if (!time_ok)
+    bad("--time", o.time,
+        "a Slurm wall time above zero: MINUTES, MM:SS, HH:MM:SS, DAYS-HH, DAYS-HH:MM or DAYS-HH:MM:SS (e.g. 02:00:00)");
+  static const std::regex mem_re(R"([1-9][0-9]{0,8}[KMGT]?)");
+  if (!o.mem.empty() && !std::regex_match(o.mem, mem_re))
+    bad("--mem", o.mem, "a memory size: a whole number above 0 with an optional unit K, M, G or T (e.g. 4G; no unit: MB)");
+  static const std::regex name_re(R"([A-Za-z0-9_.-]+(,[A-Za-z0-9_.-]+)*)");
+  if (!o.partition.empty() && !std::regex_match(o.partition, name_re))
+    bad("--partition", o.partition, "a Slurm partition name (letters, digits, '_', '.', '-'; a comma between several)");
+  static const std::regex account_re(R"([A-Za-z0-9_.-]+)");
+  if (!o.account.empty() && !std::regex_match(o.account, account_re))
+    bad("--account", o.account, "a Slurm account name (letters, digits, '_', '.', '-')");
+  if (o.max_parallel < 0) bad("--max-parallel", std::to_string(o.max_parallel), "a whole number >= 0 (0: no limit)");
+  if (o.np < 1) bad("--np", std::to_string(o.np), "a whole number >= 1");
+  // The run folder appears in #SBATCH --output="..." and in the scripts:
+  // one line, no quote or '%' (Slurm's file-name pattern character).
+  const std::string out = fs::absolute(o.output).string();
+  for (char c : out)
+    if (std::iscntrl(static_cast<unsigned char>(c)) || c == '"' || c == '%' || c == '\\')
+      bad("--output", out, "a run folder path without control characters, '\"', '%' or '\\' (it is written into "
+                           "#SBATCH lines)");
+}
 
 std::string write_hpc_scripts(const config::CaseConfig& cfg, const HpcOptions& o, int n_tasks,
                               const std::string& exe) {
@@ -38,6 +85,7 @@ std::string write_hpc_scripts(const config::CaseConfig& cfg, const HpcOptions& o
                                           o.scheduler));
   if (o.stage == "all")
     throw config::ConfigError("--stage: expected one stage (an array runs the jobs of one stage), got 'all'");
+  check_hpc_options(o);
   if (n_tasks <= 0)
     throw config::ConfigError(fmt::format("--stage {}: the stage has no jobs yet (its inputs come from an earlier "
                                           "stage that has not run)", o.stage));

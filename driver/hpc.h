@@ -22,6 +22,11 @@ struct HpcOptions {
   int max_parallel = 0;          // %N throttle of the array, 0 = none
 };
 
+// Throws a ConfigError naming the option when a value cannot go into an
+// #SBATCH line as given: Slurm time and memory formats, names without
+// blanks or control characters, counts in range, a run folder on one line.
+void check_hpc_options(const HpcOptions& opt);
+
 // Write <output>/hpc/<stage>.array.sh, <stage>.merge.sh and submit_<stage>.sh;
 // returns a short text for the user. Throws ConfigError on bad options.
 std::string write_hpc_scripts(const config::CaseConfig& cfg, const HpcOptions& opt, int n_tasks,

@@ -9,9 +9,12 @@
 #include <chrono>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <mutex>
 #include <sstream>
 #include <thread>
+
+#include <yaml-cpp/yaml.h>
 
 #include "engine/runner.h"
 #include "jobs/job_store.h"
@@ -42,10 +45,33 @@ struct JobRow {
   jobs::Verdict verdict;
 };
 
-std::vector<JobRow> decide_all(const jobs::JobStore& store, const Plan& plan, bool force) {
+// Per job: run, skip or busy. A job marked done whose declared outputs are
+// missing or damaged is run again, and the reason says which file.
+std::vector<JobRow> decide_all(const Stage& stage, const StageContext& ctx, const jobs::JobStore& store,
+                               const Plan& plan, bool force) {
   std::vector<JobRow> rows;
-  for (const auto& j : plan.jobs) rows.push_back({j, store.decide(j.label, j.inputs, force)});
+  for (const auto& j : plan.jobs) {
+    jobs::Verdict v = store.decide(j.label, j.inputs, force);
+    if (v.decision == jobs::Decision::Skip)
+      if (const std::string why = stage.damaged_outputs(ctx, j); !why.empty())
+        v = {jobs::Decision::Run, "done before, but an output is damaged: " + why};
+    rows.push_back({j, v});
+  }
   return rows;
+}
+
+// Two jobs of a stage with one label would share a folder and overwrite each
+// other: the conditions are equal, or differ past the label's precision.
+void check_unique_labels(const std::string& stage, const Plan& plan) {
+  std::map<std::string, size_t> seen;
+  for (size_t i = 0; i < plan.jobs.size(); ++i) {
+    const auto [it, fresh] = seen.emplace(plan.jobs[i].label, i);
+    if (!fresh)
+      throw config::ConfigError(fmt::format(
+          "stage {}: jobs {} ({}) and {} ({}) have the same label '{}': their conditions are equal or differ past the "
+          "label's precision; give each condition once, with values that differ in the first 6 digits",
+          stage, it->second, plan.jobs[it->second].summary, i, plan.jobs[i].summary, plan.jobs[i].label));
+  }
 }
 
 std::string verdict_tag(const jobs::Verdict& v) {
@@ -67,6 +93,7 @@ void write_provenance(const config::CaseConfig& cfg, const fs::path& run_dir) {
   nlohmann::json j = {{"case_file", cfg.file.string()},   {"ore_card", cfg.ore_file.string()},
                       {"case", cfg.doc.to_json()},         {"ore", cfg.ore.to_json()},
                       {"orchestrate_version", MILL_VERSION}};
+  j["case_name"] = cfg.name;
   jobs::atomic_write(run_dir / "resolved_case.json", j.dump(2) + "\n");
 }
 
@@ -112,6 +139,13 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
 
   if (inv.dry_run)
     out << fmt::format("plan for case '{}' ({}), output {}\n", cfg.name, cfg.file.string(), run_dir.string());
+  // Every stage's plan as far as it is known now, before any stage runs: a
+  // label clash in a late stage must not surface after hours of earlier ones.
+  for (const auto& name : inv.stages) {
+    auto it = std::find_if(stages.begin(), stages.end(), [&](const auto& s) { return s->name() == name; });
+    StageContext ctx{cfg, inv.opts, run_dir, run_dir / name, runner, progress};
+    check_unique_labels(name, (*it)->plan(ctx));
+  }
 
   for (const auto& name : inv.stages) {
     auto it = std::find_if(stages.begin(), stages.end(), [&](const auto& s) { return s->name() == name; });
@@ -119,7 +153,15 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
     StageContext ctx{cfg, inv.opts, run_dir, run_dir / name, runner, progress};
     const jobs::JobStore store(ctx.stage_dir);
     const Plan plan = stage.plan(ctx);
-    const auto rows = decide_all(store, plan, inv.opts.force);
+    check_unique_labels(name, plan);
+    if (inv.task && (*inv.task < 0 || *inv.task >= static_cast<int>(plan.jobs.size())))
+      throw config::ConfigError(
+          plan.jobs.empty()
+              ? fmt::format("--task: stage '{}' has no jobs yet{}, got --task {}", name,
+                            plan.note.empty() ? "" : " (" + plan.note + ")", *inv.task)
+              : fmt::format("--task: expected an index in [0, {}] for stage '{}' ({} job{}), got {}",
+                            plan.jobs.size() - 1, name, plan.jobs.size(), plan.jobs.size() == 1 ? "" : "s", *inv.task));
+    const auto rows = decide_all(stage, ctx, store, plan, inv.opts.force);
     const int n_done = static_cast<int>(std::count_if(rows.begin(), rows.end(), [](const JobRow& r) {
       return r.verdict.decision == jobs::Decision::Skip;
     }));
@@ -143,9 +185,6 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
 
     std::vector<JobRow> todo;
     if (inv.task) {
-      if (*inv.task < 0 || *inv.task >= static_cast<int>(rows.size()))
-        throw config::ConfigError(fmt::format("--task: expected an index in [0, {}] for stage '{}', got {}",
-                                              static_cast<int>(rows.size()) - 1, name, *inv.task));
       todo.push_back(rows[*inv.task]);
     } else {
       todo = rows;
@@ -222,6 +261,38 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
   return kExitOk;
 }
 
+void check_run_folder(const config::CaseConfig& cfg, const fs::path& run_dir, bool force) {
+  if (force) return;
+  const fs::path resolved = run_dir / "resolved_case.json", copy = run_dir / "case.yaml";
+  std::string owner, owner_file;
+  std::error_code ec;
+  if (fs::exists(resolved, ec)) {
+    std::ifstream in(resolved);
+    const auto j = nlohmann::json::parse(in, nullptr, false);
+    if (!j.is_object())
+      throw config::ConfigError(fmt::format("--output {}: {} is damaged (not a JSON object), so the folder's case is "
+                                            "unknown; use another --output, or --force to take the folder over",
+                                            run_dir.string(), resolved.string()));
+    owner_file = j.value("case_file", std::string());
+    if (j.contains("case_name") && j["case_name"].is_string()) owner = j["case_name"].get<std::string>();
+    else if (j.contains("case") && j["case"].is_object() && j["case"].contains("name") && j["case"]["name"].is_string())
+      owner = j["case"]["name"].get<std::string>();
+    else if (!owner_file.empty()) owner = fs::path(owner_file).stem().string();
+  } else if (fs::exists(copy, ec)) {
+    try {
+      const YAML::Node n = YAML::LoadFile(copy.string());
+      if (n.IsMap() && n["name"] && n["name"].IsScalar()) owner = n["name"].Scalar();
+    } catch (const YAML::Exception&) {
+    }
+  }
+  if (owner.empty() || owner == cfg.name) return;
+  throw config::ConfigError(fmt::format(
+      "--output {}: the run folder belongs to case '{}'{}; this is case '{}' ({}): use another --output (the default "
+      "is runs/{}), or --force to take the folder over (every job is then redone)",
+      run_dir.string(), owner, owner_file.empty() ? "" : " (" + owner_file + ")", cfg.name, cfg.file.string(),
+      cfg.name));
+}
+
 int count_tasks(const config::CaseConfig& cfg, const Invocation& inv) {
   auto stages = make_stages();
   engine::Runner runner;
@@ -240,12 +311,38 @@ int run_single_impact(const config::CaseConfig& cfg, const RunOptions& opts, dou
   engine::Runner runner;
   Progress progress(out, isatty(STDOUT_FILENO) && &out == &std::cout);
   StageContext ctx{cfg, opts, opts.output, opts.output / "breakage", runner, progress};
-  write_provenance(cfg, opts.output);
   const std::string label = fmt::format("impact_v{:g}_a{:g}_r{}", velocity, angle, repeat);
+  // The output folder is the job's folder: an identical rerun is skipped.
+  const jobs::JobStore store = jobs::JobStore::single(opts.output);
+  const nlohmann::json inputs = impact_inputs(ctx, velocity, angle, repeat);
+  jobs::Verdict v = store.decide(label, inputs, opts.force);
+  if (v.decision == jobs::Decision::Skip)
+    if (const std::string why = damaged_impact_outputs(opts.output); !why.empty())
+      v = {jobs::Decision::Run, "done before, but an output is damaged: " + why};
+  if (v.decision == jobs::Decision::Busy)
+    throw std::runtime_error(fmt::format("impact into {}: {}", opts.output.string(), v.why));
+  if (v.decision == jobs::Decision::Skip) {
+    std::ifstream in(opts.output / "result.json");
+    out << impact_line(nlohmann::json::parse(in, nullptr, false)) << "\n"
+        << "already done with the same inputs (job " << jobs::job_id(inputs) << "): " << opts.output.string()
+        << "; --force redoes it\n";
+    return kExitOk;
+  }
+  write_provenance(cfg, opts.output);
+  if (v.why != "new") progress.info(fmt::format("impact: rerun: {}", v.why));
   progress.info(fmt::format("impact: {}-element lump of {} at {:g} m/s, {:g} deg, into {}", cfg.doc.integer("lump.n_elements"),
                             cfg.ore.str("name"), velocity, angle, opts.output.string()));
   progress.stage_begin("impact", 1, 0);
-  const std::string line = run_impact(ctx, velocity, angle, repeat, opts.output, label);
+  store.mark_running(label, inputs);
+  std::string line;
+  try {
+    line = run_impact(ctx, velocity, angle, repeat, opts.output, label);
+  } catch (const std::exception& e) {
+    const std::string why = e.what();
+    store.mark_failed(label, why.substr(0, why.find('\n')));
+    throw;
+  }
+  store.mark_done(label);
   progress.stage_end();
   out << line << "\n"
       << "written: " << (opts.output / "summary.csv").string() << ", fractions.csv, impact.h5, fragments.vtp, result.json\n";

@@ -35,6 +35,10 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
 int run_single_impact(const config::CaseConfig& cfg, const RunOptions& opts, double velocity, double angle,
                       int repeat, std::ostream& out);
 
+// A run folder belongs to one case: throws a ConfigError naming both cases
+// when `run_dir` holds another case's results (unless `force`).
+void check_run_folder(const config::CaseConfig& cfg, const std::filesystem::path& run_dir, bool force);
+
 // Number of jobs the (single) stage of `inv` has for this case.
 int count_tasks(const config::CaseConfig& cfg, const Invocation& inv);
 

@@ -5,11 +5,13 @@
 // the partner's tag and the bond's history (initial length, shear force,
 // bending moment, twisting moment). The history is mirrored on both atoms and
 // always expressed in the canonical direction lower tag -> higher tag, so that
-// two ranks that each own one end compute bitwise the same bond.
-// Each rank keeps a list of the bonds it computes (atom indices, history
-// slots and the bond's constants), rebuilt only when atoms are exchanged,
-// sorted or re-ghosted and after a break, so that the per-step loop does no
-// tag lookups.
+// two ranks that each own one end compute bitwise the same bond; the slots
+// are what moves with an atom between ranks and what a restart file holds.
+// During a run each rank works on one entry per bond it computes (atom
+// indices, the history and the bond's constants, contiguous), rebuilt only
+// when atoms are exchanged, sorted or re-ghosted and after a break, so that
+// the per-step loop does no tag lookups and touches no per-atom slot; the
+// history goes back to the slots of both ends before anything reads them.
 #ifndef MILL_FIX_BOND_BREAKABLE_H
 #define MILL_FIX_BOND_BREAKABLE_H
 
@@ -33,6 +35,8 @@ class FixBondBreakable : public Fix {
   void setup(int vflag) override;
   void post_force(int vflag) override;
   void end_of_step() override;
+  void setup_pre_exchange() override;
+  void pre_exchange() override;
   void post_run() override;
 
   double compute_vector(int n) override;
@@ -102,27 +106,38 @@ class FixBondBreakable : public Fix {
   FILE *break_log_ = nullptr;   // rank 0 only
   std::vector<double> events_;  // break events of this step (local)
 
-  // Bonds this rank computes, in the order of the per-atom slots (owned atom i
-  // ascending, slot descending; a bond with both ends owned here is listed
-  // once, under its lower tag). Valid until atoms are exchanged, sorted or
-  // re-ghosted (a neighbour-list build), a bond breaks, or storage grows.
+  // One entry per bond this rank computes, in the order of the per-atom slots
+  // (owned atom i ascending, slot descending; a bond with both ends owned
+  // here is listed once, under its lower tag). While the list is current the
+  // entry's history is the bond's state and the per-atom slots are stale
+  // (history_dirty_); store_history() writes it back to the slots of both
+  // ends before anything reads or moves them (exchange, sort, restart, dump,
+  // a break, storage growth, the end of a run). Valid until atoms are
+  // exchanged, sorted or re-ghosted (a neighbour-list build), a bond breaks,
+  // storage grows or the time step changes.
   struct ListedBond {
-    int a, b;        // atom indices, a = lower tag (b may be a ghost image)
-    int i;           // owned atom whose slot holds the history
-    int j;           // the partner if it is owned here, else -1
-    double *hist;    // history slot on i
-    double *mirror;  // the partner's copy of the history (j >= 0), else nullptr
-    bool i_lower;    // tag[i] < partner tag
-    // Constants of the bond (radii and L0 do not change during a run):
-    double rbond, area, inertia, polar;  // disc radius [m], A [m^2], I, J [m^4]
-    double inv_area, inv_inertia;        // 1/A, 1/I
-    double kn, ks;                       // stiffness per area [Pa/m]
+    int a, b;          // atom indices, a = lower tag (b may be a ghost image)
+    int i;             // owned atom whose slot holds the history
+    int j;             // the partner if it is owned here, else -1
+    int slot_i;        // slot of the bond on i
+    int slot_j;        // slot on j (j >= 0), else -1
+    bool i_lower;      // tag[i] < partner tag
+    // History, canonical frame (columns FS, MB, MT, STATE of the slots):
+    double fs[3], mb[3], mt, state;
+    // Constants of the bond (radii, masses and L0 do not change during a run):
+    double l0;                           // initial length [m]
+    double rbond, inv_area, inv_inertia;  // disc radius [m], 1/A [1/m^2], 1/I [1/m^4]
+    double kna, ksa;                     // kn A, ks A [N/m]
+    double kni, ksj;                     // kn I, ks J [N m]
+    double cn, cs;                       // dashpots (damping > 0) [N s/m]
     double drop_len;                     // a contact is dropped beyond this length [m]
   };
   std::vector<ListedBond> list_;
   bool list_valid_ = false;
-  bigint list_ncalls_ = -1;  // neighbor->ncalls when the list was built
+  bool history_dirty_ = false;  // list_ holds history not yet in the slots
+  bigint list_ncalls_ = -1;     // neighbor->ncalls when the list was built
   int list_nlocal_ = -1, list_nghost_ = -1;
+  double list_dt_ = 0.0;        // update->dt when the list was built
   std::vector<int> broken_;   // slots to remove this step: i, j, tag i, partner tag
   std::vector<int> contact_;  // bonds that became contacts this step: list entries
 
@@ -133,10 +148,11 @@ class FixBondBreakable : public Fix {
   void parse_args(int narg, char **arg);
   void create_bonds();
   void compute_bonds(bool advance);
-  void evaluate_bond(const AtomArrays &at, const ListedBond &bond, bool advance,
+  void evaluate_bond(const AtomArrays &at, ListedBond &bond, bool advance,
                      BondResult &out) const;
-  bool evaluate_contact(const AtomArrays &at, const ListedBond &bond, bool advance,
+  bool evaluate_contact(const AtomArrays &at, ListedBond &bond, bool advance,
                         BondResult &out) const;
+  void store_history();
   void remove_slot(int i, int slot);
   int find_slot(int i, int partner_tag) const;
   int intact_bonds(int i) const;

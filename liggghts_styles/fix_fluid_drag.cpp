@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
@@ -44,6 +45,22 @@ FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, a
       const std::string msg =
           std::string("fix fluid/drag: cannot read field '") + field_path_ + "': " + e.what();
       error->one(FLERR, msg.c_str());
+    }
+    // The field is the gas of one rotor speed: a deck that turns the
+    // flywheel at another speed would drag lumps with the wrong gas.
+    if (have_omega_) {
+      const double field_omega = field_->rpm * 2.0 * kPi / 60.0;
+      // 1e-4 relative: a hand-typed omega (209.44 for 2000 rpm) passes, another speed does not.
+      const double tol = 1e-4 * std::max(std::fabs(omega_), std::fabs(field_omega));
+      if (!(std::fabs(field_omega - omega_) <= tol)) {
+        char m[512];
+        snprintf(m, sizeof(m),
+                 "fix fluid/drag: field '%s' was sampled at %.10g rpm (omega %.10g rad/s) but "
+                 "the deck's omega is %.10g rad/s (%.10g rpm); sample the flow at this rotor "
+                 "speed or give the field's omega",
+                 field_path_.c_str(), field_->rpm, field_omega, omega_, omega_ * 60.0 / (2.0 * kPi));
+        error->all(FLERR, m);
+      }
     }
     if (comm->me == 0) {
       char line[512];
@@ -92,17 +109,24 @@ void FixFluidDrag::parse_args(int narg, char **arg) {
         fail("uniform gas density must be > 0 kg/m^3, got " + std::string(arg[iarg + 4]));
       uniform_ = true;
       iarg += 5;
+    } else if (key == "omega") {
+      need(iarg, 1, key);
+      omega_ = args.real("omega", arg[iarg + 1]);
+      have_omega_ = true;
+      iarg += 2;
     } else if (key == "buoyancy") {
       need(iarg, 3, key);
       for (int d = 0; d < 3; ++d) gravity_[d] = args.real("buoyancy", arg[iarg + 1 + d]);
       iarg += 4;
     } else {
-      fail("unknown keyword '" + key + "' (expected viscosity, field, uniform, buoyancy)");
+      fail("unknown keyword '" + key + "' (expected viscosity, field, uniform, omega, buoyancy)");
     }
   }
   if (!have_viscosity) fail("keyword 'viscosity' (gas dynamic viscosity, Pa s) is required");
   if (have_field == uniform_)
     fail("give exactly one of 'field FILE' (sampled gas field, HDF5) or 'uniform ux uy uz rho'");
+  if (have_omega_ && uniform_)
+    fail("'omega' checks the rotor speed of a sampled field; it needs 'field FILE', not 'uniform'");
 }
 
 int FixFluidDrag::setmask() {

@@ -52,6 +52,8 @@ class FixFluidDrag : public Fix {
   double rho_uniform_ = 0.0;                  // uniform gas density            [kg/m^3]
   std::array<double, 3> gravity_{0, 0, 0};    // g for buoyancy; 0 = none       [m/s^2]
   std::string field_path_;
+  bool have_omega_ = false;  // `omega W`: the deck's rotor speed, checked
+  double omega_ = 0.0;       //   against the field's rpm              [rad/s]
   std::unique_ptr<mill::post::FlowField> field_;
 
   // Cached once-per-step reductions (read by compute_vector).

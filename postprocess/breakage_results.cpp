@@ -491,7 +491,11 @@ std::vector<FractionRow> ReadFractionsCsv(const std::string& path) {
     double v[7];
     for (std::size_t c = 0; c < names.size(); ++c)
       v[c] = ParseCsvNumber(path, line_no, names[c], cells[c]);
-    if (v[3] < 0 || v[3] != static_cast<int>(v[3])) {
+    if (!(std::isfinite(v[2]) && v[2] >= 0 && v[2] == std::round(v[2]) && v[2] < 1e9)) {
+      throw PostError(fmt::format("{}:{}: repeat: expected a whole number >= 0, got '{}'", path,
+                                  line_no, cells[2]));
+    }
+    if (!(std::isfinite(v[3]) && v[3] >= 0 && v[3] == std::round(v[3]) && v[3] < 1e9)) {
       throw PostError(fmt::format("{}:{}: fraction_index: expected a whole number >= 0, got '{}'",
                                   path, line_no, cells[3]));
     }
@@ -534,8 +538,15 @@ std::vector<ImpactSummary> ReadSummaryCsv(const std::string& path) {
     ImpactSummary s;
     for (std::size_t c = 0; c < cols.size(); ++c) {
       if (pos[c] < 0) continue;
-      cols[c].set(s, ParseCsvNumber(path, line_no, cols[c].name,
-                                    cells[static_cast<std::size_t>(pos[c])]));
+      const std::string& cell = cells[static_cast<std::size_t>(pos[c])];
+      const double v = ParseCsvNumber(path, line_no, cols[c].name, cell);
+      // A count or flag that is not a whole number (nan, 2.5) would turn
+      // into garbage when rounded: the file is damaged.
+      if (cols[c].integer && !(std::isfinite(v) && v == std::round(v) && std::abs(v) < 9e15)) {
+        throw PostError(fmt::format("{}:{}: {}: expected a whole number, got '{}'", path, line_no,
+                                    cols[c].name, cell));
+      }
+      cols[c].set(s, v);
     }
     rows.push_back(s);
   }

@@ -3,14 +3,25 @@
 
 #include <fmt/format.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <set>
 #include <sstream>
 
 namespace mill::config {
 namespace fs = std::filesystem;
+
+namespace {
+// A case file or ore card is a page of keys; anything far larger is not one.
+constexpr long long kMaxYamlBytes = 16 << 20;
+}  // namespace
 
 size_t edit_distance(const std::string& a, const std::string& b) {
   std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
@@ -208,12 +219,48 @@ Document Document::parse(const std::string& text, const std::string& file_label,
   return d;
 }
 
+std::string read_regular_file(const fs::path& file, const std::string& what) {
+  // stat first: a directory reads as empty and a FIFO blocks in open().
+  struct stat st {};
+  if (::stat(file.c_str(), &st) != 0)
+    throw ConfigError(errno == ENOENT ? fmt::format("{}: {} not found", file.string(), what)
+                                      : fmt::format("{}: cannot open {}: {}", file.string(), what, std::strerror(errno)));
+  if (S_ISDIR(st.st_mode))
+    throw ConfigError(fmt::format("{}: is a directory; expected a {} (a YAML file)", file.string(), what));
+  if (!S_ISREG(st.st_mode))
+    throw ConfigError(fmt::format("{}: is not a regular file (a FIFO, socket or device); expected a {} (a YAML file)",
+                                  file.string(), what));
+  if (st.st_size > kMaxYamlBytes)
+    throw ConfigError(fmt::format("{}: {} bytes; expected a {} of at most {} bytes", file.string(), st.st_size, what,
+                                  kMaxYamlBytes));
+  // Non-blocking: the path may have been swapped for a FIFO since the stat.
+  const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw ConfigError(fmt::format("{}: cannot open {}: {}", file.string(), what, std::strerror(errno)));
+  struct stat st2 {};
+  if (::fstat(fd, &st2) != 0 || !S_ISREG(st2.st_mode)) {
+    ::close(fd);
+    throw ConfigError(fmt::format("{}: is not a regular file; expected a {} (a YAML file)", file.string(), what));
+  }
+  std::string text;
+  char buf[65536];
+  for (;;) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int e = errno;
+      ::close(fd);
+      throw ConfigError(fmt::format("{}: cannot read {}: {}", file.string(), what, std::strerror(e)));
+    }
+    if (n == 0) break;
+    text.append(buf, static_cast<size_t>(n));
+    if (static_cast<long long>(text.size()) > kMaxYamlBytes) break;
+  }
+  ::close(fd);
+  return text;
+}
+
 Document Document::load(const fs::path& file, const Schema& schema) {
-  std::ifstream in(file);
-  if (!in) throw ConfigError(fmt::format("{}: cannot open {} (no such file or not readable)", file.string(), schema.what));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse(ss.str(), file.string(), schema);
+  return parse(read_regular_file(file, schema.what), file.string(), schema);
 }
 
 const KeyDef& Document::def(const std::string& path) const {
@@ -300,6 +347,104 @@ void check_ore(const Document& ore) {
 
 namespace {
 
+constexpr double kPi = 3.14159265358979323846;
+// Highest flywheel tip speed accepted: a steel rim's hoop stress rho v^2
+// reaches its strength (~700 MPa at 7850 kg/m^3) near 300 m/s.
+constexpr double kMaxTipSpeed = 300.0;
+// Most steps a transport run may take, and how far (x lump radius) a lump
+// at the tip speed may move in one step.
+constexpr double kMaxSteps = 1e9;
+constexpr double kMaxStepMove = 0.25;
+
+// A list key's items given twice: each one is a job (or part of a job
+// label), so a repeated item would run twice into one folder.
+void check_unique_items(const Document& d, const std::string& key, const char* unit) {
+  const auto v = d.reals(key);
+  for (size_t i = 0; i < v.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      if (v[i] == v[j])
+        throw ConfigError(fmt::format("{}[{}]: {:g} {} is listed twice (also item {}): expected each value once",
+                                      d.where(key), i, v[i], unit, j));
+}
+
+// Values that pass the schema one by one but make no physical sense, alone
+// or together: speeds no mill reaches, lumps bigger than the beaters, time
+// steps longer than the run or than a lump may move in one step.
+void check_physics(const Document& d) {
+  auto fail = [&](const std::string& key, const std::string& msg) {
+    throw ConfigError(fmt::format("{}: {}", d.where(key), msg));
+  };
+  const double D = d.real("mill.flywheel.diameter"), hub = d.real("mill.flywheel.hub_diameter");
+  const auto rpms = d.reals("rotor.rpm");
+  double tip_max = 0;
+  for (size_t i = 0; i < rpms.size(); ++i) {
+    const double tip = kPi * D * rpms[i] / 60.0;
+    tip_max = std::max(tip_max, tip);
+    if (tip > kMaxTipSpeed)
+      throw ConfigError(fmt::format(
+          "{}[{}]: a {:g} m flywheel at {:g} rpm has a tip speed of {:.0f} m/s; expected at most {:g} m/s (beater "
+          "mills run at 50-150 m/s; a steel rim bursts near {:g} m/s): at this diameter, rotor.rpm <= {:.0f}",
+          d.where("rotor.rpm"), i, D, rpms[i], tip, kMaxTipSpeed, kMaxTipSpeed, kMaxTipSpeed * 60.0 / (kPi * D)));
+  }
+  check_unique_items(d, "rotor.rpm", "rpm");
+  check_unique_items(d, "breakage.velocities", "m/s");
+  check_unique_items(d, "breakage.angles", "deg");
+
+  // The lump against the beaters: a plate reaches (D - hub) / 2 from the hub.
+  const double plate = (D - hub) / 2;
+  for (const char* key : {"injection.lump_diameter", "lump.diameter"})
+    if (d.real(key) >= plate)
+      fail(key, fmt::format("a {:g} m lump is not smaller than the beater plates ({:g} m from hub to tip: "
+                            "mill.flywheel.diameter {:g} m, hub_diameter {:g} m); expected a lump smaller than {:g} m",
+                            d.real(key), plate, D, hub, plate));
+
+  // Transport: the run must outlast the injection and hold many steps.
+  const double duration = d.real("injection.duration"), t_limit = d.real("injection.time_limit");
+  const double dt = d.real("injection.timestep");
+  if (!(t_limit > duration))
+    fail("injection.time_limit", fmt::format("expected longer than injection.duration ({:g} s), got {:g} s: the run "
+                                             "would stop before every lump is in",
+                                             duration, t_limit));
+  if (dt > t_limit / 10)
+    fail("injection.timestep", fmt::format("expected at most a tenth of injection.time_limit ({:g} s), got {:g} s",
+                                           t_limit, dt));
+  if (t_limit / dt > kMaxSteps)
+    fail("injection.timestep", fmt::format("{:g} s over injection.time_limit {:g} s is {:.3g} steps; expected at most "
+                                           "{:g} steps (a step of at least {:.3g} s)",
+                                           dt, t_limit, t_limit / dt, kMaxSteps, t_limit / kMaxSteps));
+  // A lump flung at the tip speed may move a fraction of its radius per step,
+  // or it passes through a beater plate between two contact checks.
+  const double r_lump = d.real("injection.lump_diameter") / 2;
+  if (tip_max * dt > kMaxStepMove * r_lump)
+    fail("injection.timestep",
+         fmt::format("at the tip speed {:.0f} m/s a lump moves {:.3g} m per step, more than {:g} of its radius ({:g} m); "
+                     "expected injection.timestep <= {:.3g} s",
+                     tip_max, tip_max * dt, kMaxStepMove, r_lump, kMaxStepMove * r_lump / tip_max));
+  if (d.real("transport.trajectory_interval") >= t_limit)
+    fail("transport.trajectory_interval",
+         fmt::format("expected shorter than injection.time_limit ({:g} s), got {:g} s: no trajectory point would be kept",
+                     t_limit, d.real("transport.trajectory_interval")));
+
+  // Sampling: a grid needs at least 3 points across the narrowest housing side.
+  const double side = std::min({d.real("mill.housing.width"), d.real("mill.housing.height"), d.real("mill.housing.depth")});
+  if (d.real("sample.spacing") > side / 2)
+    fail("sample.spacing", fmt::format("expected at most half the narrowest housing side ({:g} m of {:g} m), got {:g} m",
+                                       side / 2, side, d.real("sample.spacing")));
+
+  // The outlet's absolute pressure must stay above vacuum.
+  if (d.real("gas.outlet_pressure_drop") >= d.real("gas.pressure"))
+    fail("gas.outlet_pressure_drop",
+         fmt::format("expected less than gas.pressure ({:g} Pa): the outlet would be at or below vacuum, got {:g} Pa",
+                     d.real("gas.pressure"), d.real("gas.outlet_pressure_drop")));
+
+  // Breakage: a given time step must be well inside the simulated time.
+  const double after = d.real("breakage.duration_after_contact"), bdt = d.real("breakage.timestep");
+  if (bdt > after / 10)
+    fail("breakage.timestep", fmt::format("expected 0 (automatic) or at most a tenth of breakage.duration_after_contact "
+                                          "({:g} s), got {:g} s",
+                                          after, bdt));
+}
+
 // Cross-key checks of a case: the geometry must fit, lists must be ordered.
 void check_case(const Document& d) {
   auto fail = [&](const std::string& key, const std::string& msg) {
@@ -335,6 +480,7 @@ void check_case(const Document& d) {
   if (d.real("injection.lump_diameter") >= d.real("mill.inlet.size"))
     fail("injection.lump_diameter", fmt::format("expected smaller than the inlet ({:g} m), got {:g} m",
                                                 d.real("mill.inlet.size"), d.real("injection.lump_diameter")));
+  check_physics(d);
 }
 
 // Ore card path: absolute; else relative to the case file; else to the project.
@@ -351,6 +497,12 @@ fs::path resolve_ore(const Document& d, const fs::path& case_file, const fs::pat
   }
   for (const auto& t : tried)
     if (fs::is_regular_file(t)) return fs::weakly_canonical(t);
+  for (const auto& t : tried) {
+    std::error_code ec;
+    if (fs::exists(t, ec))
+      throw ConfigError(fmt::format("{}: ore card '{}' is {}; expected an ore card (a YAML file)", d.where("ore.card"),
+                                    t.string(), fs::is_directory(t, ec) ? "a directory" : "not a regular file"));
+  }
   std::string where;
   for (const auto& t : tried) where += "\n  " + t.string();
   std::string have;
@@ -366,21 +518,22 @@ fs::path resolve_ore(const Document& d, const fs::path& case_file, const fs::pat
 
 CaseConfig load_case(const fs::path& file, const fs::path& project_dir,
                      const std::vector<std::pair<std::string, std::string>>& overrides) {
-  if (!fs::exists(file)) throw ConfigError(fmt::format("{}: case file not found", file.string()));
   CaseConfig c;
   c.file = fs::weakly_canonical(file);
   c.project_dir = project_dir;
-  {
-    std::ifstream in(file);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    c.doc = Document::parse(ss.str(), file.string(), case_schema(), overrides);
-  }
+  c.doc = Document::parse(read_regular_file(file, "case file"), file.string(), case_schema(), overrides);
   check_case(c.doc);
   c.name = c.doc.has("name") ? c.doc.str("name") : file.stem().string();
+  // The name becomes the run folder runs/<name>: one plain path component.
+  const std::string where_name =
+      c.doc.has("name") ? c.doc.where("name") : fmt::format("{}: name (from the file name)", file.string());
   for (char ch : c.name)
     if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.'))
-      throw ConfigError(fmt::format("{}: expected letters, digits, '-', '_' or '.', got '{}'", c.doc.where("name"), c.name));
+      throw ConfigError(fmt::format("{}: expected letters, digits, '-', '_' or '.', got '{}'", where_name, c.name));
+  if (!std::isalnum(static_cast<unsigned char>(c.name[0])))
+    throw ConfigError(fmt::format("{}: expected a name that starts with a letter or digit (it names the run folder "
+                                  "runs/<name>), got '{}'",
+                                  where_name, c.name));
   c.ore_file = resolve_ore(c.doc, file, project_dir);
   c.ore = Document::load(c.ore_file, ore_schema());
   check_ore(c.ore);

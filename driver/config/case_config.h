@@ -66,6 +66,11 @@ struct CaseConfig {
 CaseConfig load_case(const std::filesystem::path& file, const std::filesystem::path& project_dir,
                      const std::vector<std::pair<std::string, std::string>>& overrides = {});
 
+// The text of a case file or ore card (`what` names it in messages): a
+// ConfigError, never a hang, when the path is missing, a directory, a FIFO
+// or another non-regular file, or unreadable.
+std::string read_regular_file(const std::filesystem::path& file, const std::string& what);
+
 // Physical consistency of an ore card (UCS > tensile strength, ...).
 void check_ore(const Document& ore);
 

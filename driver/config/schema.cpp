@@ -87,6 +87,8 @@ Schema make_case_schema() {
              "tiny: a few thousand cells (tests); quick: tens of thousands; reference: ~600k with layers"),
       at_least(key("flow.max_iterations", T::Int, "", "600", "Iteration cap of the steady solver"), 1),
       positive(key("flow.residual_target", T::Real, "", "1e-4", "Initial-residual target for p and U (convergence)")),
+      key("flow.allow_unconverged", T::Bool, "", "false",
+          "Go on with a flow that missed flow.residual_target within flow.max_iterations (sample, transport and what follows run on it; the report says so at the top). false: the sample stage stops with an error naming the run"),
       choice("flow.domain", "half", {"half", "full"},
              "half: solve z >= 0 with a symmetry plane at z = 0 and mirror it (the mill is mirror-symmetric; the full-domain steady solve is carried away by an antisymmetric mode, see docs/flow.md); full: the whole housing"),
 
@@ -123,8 +125,10 @@ Schema make_case_schema() {
       // --- breakage sweep (stage 2) ---
       choice("breakage.conditions", "sweep", {"sweep", "transport"},
              "sweep: the velocities/angles below; transport: binned from stage 1 impacts"),
-      positive(key("breakage.velocities", T::RealList, "m/s", "[4, 10, 20, 40, 60, 80, 100, 120, 150, 169]",
-                   "Impact speeds of the sweep")),
+      range(key("breakage.velocities", T::RealList, "m/s", "[4, 10, 20, 40, 60, 80, 100, 120, 150, 169]",
+                "Impact speeds of the sweep (beater mills reach 50-150 m/s; above 500 m/s a rock lump is a shock "
+                "problem the bond model does not describe)"),
+            0, true, 500, false),
       range(key("breakage.angles", T::RealList, "deg", "[90]", "Impact angles to the surface (90 = normal)"), 0, true, 90, false),
       at_least(key("breakage.repeats", T::Int, "", "1", "Repeats per condition (random orientation)"), 1),
       positive(key("breakage.duration_after_contact", T::Real, "s", "6e-3", "Simulated time after first contact, at most")),

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cstdio>
 #include <cstring>
 #include <deque>
 #include <fstream>
@@ -126,7 +127,19 @@ std::vector<std::string> Runner::scan_errors(const fs::path& log, Engine e) {
   std::string l;
   while (std::getline(in, l)) {
     bool hit = false;
-    if (e == Engine::Liggghts) hit = l.rfind("ERROR", 0) == 0;  // "ERROR: ..." / "ERROR on proc N: ..."
+    if (e == Engine::Liggghts) {
+      hit = l.rfind("ERROR", 0) == 0;  // "ERROR: ..." / "ERROR on proc N: ..."
+      // Warnings that invalidate a run: elements that moved more than half
+      // the neighbour skin between list builds (contacts were missed) and
+      // elements lost from the domain.
+      long n = 0;
+      if (std::sscanf(l.c_str(), "Dangerous builds = %ld", &n) == 1 && n > 0) {
+        errs.push_back(l + " (elements moved more than half the neighbour skin between neighbour-list builds: "
+                           "contacts were missed; the time step is too long for the speeds)");
+        continue;
+      }
+      if (l.find("Lost atoms") != std::string::npos) hit = true;
+    }
     if (e == Engine::OpenFoam) hit = l.find("FOAM FATAL") != std::string::npos;
     if (hit) errs.push_back(l);
   }

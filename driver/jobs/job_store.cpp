@@ -109,7 +109,15 @@ bool JobStore::process_alive(long pid, unsigned long long start_ticks) {
 
 JobStore::JobStore(fs::path stage_dir) : stage_dir_(std::move(stage_dir)) {}
 
-fs::path JobStore::job_dir(const std::string& label) const { return stage_dir_ / "jobs" / label; }
+JobStore JobStore::single(fs::path job_dir) {
+  JobStore s(std::move(job_dir));
+  s.single_ = true;
+  return s;
+}
+
+fs::path JobStore::job_dir(const std::string& label) const {
+  return single_ ? stage_dir_ : stage_dir_ / "jobs" / label;
+}
 
 Status JobStore::read_status(const std::string& label) const {
   Status s;
@@ -127,12 +135,18 @@ Status JobStore::read_status(const std::string& label) const {
     const size_t eq = line.find('=');
     if (eq == std::string::npos) continue;
     const std::string k = line.substr(0, eq), v = line.substr(eq + 1);
-    if (k == "id") s.id = v;
-    else if (k == "pid") s.pid = std::stol(v);
-    else if (k == "host") s.host = v;
-    else if (k == "start_ticks") s.start_ticks = std::stoull(v);
-    else if (k == "reason") s.reason = v;
-    else if (k == "time") s.time = v;
+    try {
+      if (k == "id") s.id = v;
+      else if (k == "pid") s.pid = std::stol(v);
+      else if (k == "host") s.host = v;
+      else if (k == "start_ticks") s.start_ticks = std::stoull(v);
+      else if (k == "reason") s.reason = v;
+      else if (k == "time") s.time = v;
+    } catch (const std::exception&) {
+      // A damaged STATUS never reads as done: the job is run again.
+      s.state = State::Failed;
+      s.reason = fmt::format("unreadable STATUS ({}={})", k, v);
+    }
   }
   return s;
 }

@@ -45,6 +45,9 @@ void atomic_write_with(const std::filesystem::path& file, const std::function<vo
 class JobStore {
  public:
   explicit JobStore(std::filesystem::path stage_dir);
+  // A folder that is itself the job's folder (job.json and STATUS beside
+  // its outputs), e.g. the output of `orchestrate impact`.
+  static JobStore single(std::filesystem::path job_dir);
 
   std::filesystem::path job_dir(const std::string& label) const;
   Status read_status(const std::string& label) const;
@@ -64,6 +67,7 @@ class JobStore {
  private:
   void write_status(const std::string& label, const Status& s) const;
   std::filesystem::path stage_dir_;
+  bool single_ = false;  // job_dir(label) is stage_dir_ itself
 };
 
 }  // namespace mill::jobs

@@ -74,10 +74,10 @@ const std::vector<HeadlineGroup>& headline_groups() {
   return g;
 }
 
-json headline_json(const fs::path& run) {
+json headline_json(const fs::path& run, Problems* problems) {
   json h = json::object();
   for (const auto& rpm : rpm_dirs(run / "flow")) {
-    const auto f = read_json(run / "flow" / rpm / "flow_report.json");
+    const auto f = read_json(run / "flow" / rpm / "flow_report.json", problems);
     if (f.is_null()) continue;
     json e = {{"domain", pick(f, "domain")},
               {"cells", pick(f, "cells")},
@@ -95,7 +95,7 @@ json headline_json(const fs::path& run) {
     h["flow"][rpm] = e;
   }
   for (const auto& rpm : rpm_dirs(run / "transport")) {
-    const auto t = read_json(run / "transport" / rpm / "summary.json");
+    const auto t = read_json(run / "transport" / rpm / "summary.json", problems);
     if (t.is_null()) continue;
     h["transport"][rpm] = {{"lumps", pick(t, "n_particles")},
                            {"flywheel_impacts", pick(t, "n_flywheel_impacts")},
@@ -105,14 +105,14 @@ json headline_json(const fs::path& run) {
                            {"flywheel_normal_speed_mean_m_s", pick(t, "flywheel_normal_speed_mean_m_s")},
                            {"flywheel_angle_mean_deg", pick(t, "flywheel_angle_mean_deg")}};
   }
-  const auto cal = read_json(run / "calibrate" / "report.json");
+  const auto cal = read_json(run / "calibrate" / "report.json", problems);
   if (!cal.is_null())
     h["calibration"] = {{"source", pick(cal, "source")},
                         {"converged", pick(cal, "converged")},
                         {"targets", pick(cal, "targets")},
                         {"achieved", pick(cal, "achieved")},
                         {"within_tolerance", pick(cal, "within_tolerance")}};
-  const auto crit = read_json(run / "breakage" / "critical_velocity.json");
+  const auto crit = read_json(run / "breakage" / "critical_velocity.json", problems);
   if (crit.is_array()) {
     json c = json::array();
     for (const auto& e : crit)
@@ -123,7 +123,7 @@ json headline_json(const fs::path& run) {
                    {"largest_fraction_threshold", pick(e, "threshold")}});
     h["breakage"]["critical_speed"] = c;
   }
-  const auto jk = read_json(run / "breakage" / "jk_fit.json");
+  const auto jk = read_json(run / "breakage" / "jk_fit.json", problems);
   if (jk.is_array()) {
     json c = json::array();
     for (const auto& e : jk) {
@@ -135,7 +135,7 @@ json headline_json(const fs::path& run) {
     }
     h["breakage"]["jk"] = c;
   }
-  const auto prod = read_json(run / "breakage" / "product.json");
+  const auto prod = read_json(run / "breakage" / "product.json", problems);
   if (prod.is_array())
     for (const auto& p : prod)
       if (num(pick(p, "rpm")))

@@ -10,13 +10,16 @@
 #include <string>
 #include <vector>
 
+#include "report/html.h"
+
 namespace mill::report {
 
 // The headline numbers of the run folder `run` (report/summary.json's
 // "headline"): flow and transport per rotor speed ("rpm2000"), calibration,
 // breakage (critical speed, JK fit) and the mill product per rotor speed.
 // A stage that has not run is absent.
-nlohmann::json headline_json(const std::filesystem::path& run);
+// A JSON file that does not parse is left out and added to `problems`.
+nlohmann::json headline_json(const std::filesystem::path& run, Problems* problems = nullptr);
 
 // One line of the headline: the stage group it belongs to, what it is, and
 // its value in words and units with its spread where there is one.

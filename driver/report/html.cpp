@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 
 namespace mill::report {
@@ -13,13 +15,20 @@ std::string slurp(const fs::path& f) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-nlohmann::json read_json(const fs::path& f) {
+nlohmann::json read_json(const fs::path& f, Problems* problems) {
   if (!fs::exists(f)) return nullptr;
   try {
     return nlohmann::json::parse(slurp(f));
-  } catch (const std::exception&) {
+  } catch (const std::exception& e) {
+    if (problems && std::none_of(problems->begin(), problems->end(), [&](const auto& p) { return p.first == f; }))
+      problems->push_back({f, fmt::format("not valid JSON ({})", e.what())});
     return nullptr;
   }
+}
+
+std::string cell(double v, const char* spec, double scale) {
+  if (!std::isfinite(v)) return "n/a";
+  return fmt::format(fmt::runtime(spec), scale * v);
 }
 
 nlohmann::json pick(const nlohmann::json& v, const char* key) {
@@ -67,7 +76,8 @@ std::string page_head(const std::string& title) {
          "table.headline tr.group th{background:#468;color:#fff}"
          "dl.numbers{display:grid;grid-template-columns:max-content auto;gap:2px 1em}dl.numbers dt{color:#555}"
          "dl.numbers dd{margin:0;font-weight:bold}"
-         "details{margin:0.5em 0}summary{cursor:pointer;color:#468}</style></head><body>\n";
+         "details{margin:0.5em 0}summary{cursor:pointer;color:#468}"
+         ".bad{color:#a00;border:1px solid #a00;padding:0.5em}</style></head><body>\n";
 }
 
 std::string page_tail() {
@@ -81,9 +91,9 @@ void embed_png(std::ostringstream& o, const fs::path& f, const std::string& capt
 
 namespace {
 std::string fmt_value(const nlohmann::json& v) {
-  if (v.is_number_float()) return fmt::format("{:.4g}", v.get<double>());
+  if (v.is_number_float()) return cell(v.get<double>(), "{:.4g}");
   if (v.is_string()) return esc(v.get<std::string>());
-  if (v.is_null()) return "-";
+  if (v.is_null()) return "n/a";
   return esc(v.dump());
 }
 }  // namespace

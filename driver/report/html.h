@@ -8,14 +8,26 @@
 #include <filesystem>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace mill::report {
 
 // The whole file as bytes ("" when it cannot be read).
 std::string slurp(const std::filesystem::path& f);
 
-// A JSON file, or null when it does not exist or does not parse.
-nlohmann::json read_json(const std::filesystem::path& f);
+// Input files a page could not read, with the reason: named at the top of
+// the page and printed as warnings, never silently left out.
+using Problems = std::vector<std::pair<std::filesystem::path, std::string>>;
+
+// A JSON file, or null when it does not exist or does not parse; one that
+// does not parse is also added to `problems` (once) when given.
+nlohmann::json read_json(const std::filesystem::path& f, Problems* problems = nullptr);
+
+// A number for a table cell with the given precision ("{:.1f}"); a value
+// that is not a number (NaN, infinite: a damaged or degenerate result) reads
+// "n/a", never as a huge integer.
+std::string cell(double v, const char* spec, double scale = 1.0);
 
 // v[key] or null.
 nlohmann::json pick(const nlohmann::json& v, const char* key);

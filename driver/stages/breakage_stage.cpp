@@ -21,6 +21,7 @@
 
 #include "engine/liggghts.h"
 #include "jobs/job_store.h"
+#include "jobs/output_checks.h"
 #include "postprocess/breakage_results.h"
 #include "postprocess/distributions.h"
 #include "postprocess/impact_conditions.h"
@@ -37,6 +38,10 @@ namespace fs = std::filesystem;
 using engine::num;
 
 namespace {
+
+// Most an element may move in one impact step, as a share of the smallest
+// element radius.
+constexpr double kStepMove = 0.1;
 
 nlohmann::json bond_json(const BondParams& b) {
   return {{"modulus", b.modulus},   {"stiffness_ratio", b.stiffness_ratio},       {"tensile", b.tensile},
@@ -107,18 +112,65 @@ long read_long(const fs::path& f) {
   return std::lround(v);
 }
 
-}  // namespace
-
-Plan BreakageStage::plan(const StageContext& ctx) const {
-  Plan p;
-  const auto& d = ctx.cfg.doc;
+// Inputs every impact of the case shares.
+nlohmann::json impact_base_inputs(const StageContext& ctx) {
   nlohmann::json base =
-      case_keys(d, {"lump.", "breakage.duration_after_contact", "breakage.timestep", "breakage.quiet_time"});
+      case_keys(ctx.cfg.doc, {"lump.", "breakage.duration_after_contact", "breakage.timestep", "breakage.quiet_time"});
   base["ore"] = ore_keys(ctx.cfg.ore);
   base["bond"] = bond_json(bond_params_for(ctx.cfg, ctx.run_dir));
   // 4: bond/breakable with the signed tension criterion, the moment factor and
   // the exact critical step (Nov 2026): earlier results are not comparable.
-  base["deck_version"] = 4;
+  // 5: the time step also bounded by the impact speed (issue 15).
+  base["deck_version"] = 5;
+  return base;
+}
+
+}  // namespace
+
+nlohmann::json impact_inputs(const StageContext& ctx, double velocity, double angle, int repeat) {
+  nlohmann::json in = impact_base_inputs(ctx);
+  in["velocity"] = velocity;
+  in["angle"] = angle;
+  in["repeat"] = repeat;
+  return in;
+}
+
+std::string damaged_impact_outputs(const fs::path& dir) {
+  if (auto r = jobs::first_problem({jobs::check_file(dir / "summary.csv"), jobs::check_file(dir / "fractions.csv"),
+                                    jobs::check_json(dir / "result.json"), jobs::check_hdf5(dir / "impact.h5"),
+                                    jobs::check_file(dir / "fragments.vtp")});
+      !r.empty())
+    return r;
+  try {
+    const auto rows = post::ReadSummaryCsv((dir / "summary.csv").string());
+    if (rows.size() != 1) return fmt::format("{}: {} rows, expected 1", (dir / "summary.csv").string(), rows.size());
+    if (post::ReadFractionsCsv((dir / "fractions.csv").string()).empty())
+      return (dir / "fractions.csv").string() + ": no rows";
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string impact_line(const nlohmann::json& r) {
+  auto num = [&](const char* k) { return r.contains(k) && r[k].is_number() ? r[k].get<double>() : NAN; };
+  return fmt::format(
+      "{:g} m/s at {:g} deg: {} pieces ({} single, {} multi), largest {:.1f}%, single-element mass {:.1f}%, "
+      "broken bonds {:.1f}%, {:.3g} kWh/t, t10 {:.1f}%{} [{:.1f} s]",
+      num("velocity_m_s"), num("angle_deg"), num("n_pieces"), num("n_single"), num("n_multi"),
+      100 * num("largest_mass_fraction"), 100 * num("single_mass_fraction"), 100 * num("broken_bond_fraction"),
+      num("specific_energy_kWh_t"), num("t10_percent"), r.value("t10_resolved", true) ? "" : " (unresolved)",
+      num("wall_seconds"));
+}
+
+std::string BreakageStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
+  return damaged_impact_outputs(jobs::JobStore(ctx.stage_dir).job_dir(job.label));
+}
+
+Plan BreakageStage::plan(const StageContext& ctx) const {
+  Plan p;
+  const auto& d = ctx.cfg.doc;
+  const nlohmann::json base = impact_base_inputs(ctx);
   const long repeats = d.integer("breakage.repeats");
   if (d.str("breakage.conditions") == "transport") {
     // Conditions from stage 1: flywheel (and wall) impacts binned by normal speed.
@@ -158,7 +210,7 @@ Plan BreakageStage::plan(const StageContext& ctx) const {
         nlohmann::json in = base;
         in["velocity"] = v;
         in["angle"] = a;
-        in["repeat"] = r;
+        in["repeat"] = static_cast<int>(r);
         p.jobs.push_back({impact_label(v, a, static_cast<int>(r)), in,
                           fmt::format("{}-element lump at {:g} m/s, {:g} deg, repeat {}", d.integer("lump.n_elements"), v,
                                       a, r)});
@@ -180,6 +232,18 @@ std::string run_impact(StageContext& ctx, double velocity, double angle, int rep
   const double t_end = t_contact + d.real("breakage.duration_after_contact");
   const auto rot = random_rotation(1469598103ULL * static_cast<unsigned long long>(d.integer("lump.seed")) + 7919ULL * repeat);
 
+  // The time step bounds how far an element moves per step: at most a tenth
+  // of the smallest element radius (half the neighbour skin is 0.15 of the
+  // mean radius), or the lump passes through the surface between two steps.
+  const double r_min = (1.0 - d.real("lump.radius_spread")) * lump.mean_radius;
+  const double dt_speed = kStepMove * r_min / velocity;
+  const double dt_given = d.real("breakage.timestep");
+  if (dt_given > dt_speed)
+    throw std::runtime_error(fmt::format(
+        "{}: at {:g} m/s an element moves {:.3g} m per step of {:g} s, more than {:g} of the smallest element radius "
+        "({:.3g} m); expected breakage.timestep <= {:.3g} s, or 0 (automatic)",
+        d.where("breakage.timestep"), velocity, velocity * dt_given, dt_given, kStepMove, r_min, dt_speed));
+
   const fs::path work = out_dir / "run";
   fs::remove_all(work);
   engine::DeckRun run;
@@ -198,7 +262,8 @@ std::string run_impact(StageContext& ctx, double velocity, double angle, int rep
               {"t_end", num(t_end)},
               {"t_contact", num(t_contact)},
               {"quiet_time", num(d.real("breakage.quiet_time"))},
-              {"dt", num(d.real("breakage.timestep"))},
+              {"dt", num(dt_given)},
+              {"dt_speed", num(dt_speed)},
               {"skin", num(0.3 * lump.mean_radius)},
               {"binsize", num(4.0 * lump.mean_radius)},
               {"dump_interval", num(d.real("breakage.dump_interval"))},
@@ -222,6 +287,16 @@ std::string run_impact(StageContext& ctx, double velocity, double angle, int rep
   if (static_cast<long>(snap.elements.size()) != lump.elements)
     throw std::runtime_error(fmt::format("{}: {} elements in the final state, {} in the lump: elements were lost", label,
                                          snap.elements.size(), lump.elements));
+  // The surface is impenetrable: an element centre behind it means the run
+  // stepped through the contact (the result would read as an intact bounce).
+  const double z_plane = -(lump.outer_radius + gap);
+  const long behind = std::count_if(snap.elements.begin(), snap.elements.end(),
+                                    [&](const post::Element& e) { return e.x[2] < z_plane; });
+  if (behind > 0)
+    throw std::runtime_error(fmt::format(
+        "{}: {} of {} elements ended behind the impact surface: the lump passed through it between time steps, the run "
+        "is invalid (speed {:g} m/s, step bound {:.3g} s); log: {}",
+        label, behind, snap.elements.size(), velocity, dt_speed, (work / "liggghts.log").string()));
   const auto bonds = post::ReadIntactBonds((work / "bonds_final.txt").string());
   const post::ImpactResult r = post::AnalyseImpact(snap.elements, bonds, is, (work / "bonds_final.txt").string());
   for (const auto& w : r.warnings) ctx.progress.warn(label + ": " + w);
@@ -263,12 +338,7 @@ std::string run_impact(StageContext& ctx, double velocity, double angle, int rep
   fs::rename(ftmp, out_dir / "fractions.csv");
   // The raw run stays for inspection (dumps for ParaView, logs); it is small
   // next to the VTK dumps a user asks for.
-  return fmt::format(
-      "{:g} m/s at {:g} deg: {} pieces ({} single, {} multi), largest {:.1f}%, single-element mass {:.1f}%, "
-      "broken bonds {:.1f}%, {:.3g} kWh/t, t10 {:.1f}%{} [{:.1f} s]",
-      velocity, angle, s.n_pieces, s.n_single, s.n_multi, 100 * s.largest_mass_fraction, 100 * s.single_mass_fraction,
-      100 * s.broken_bond_fraction, s.specific_energy_kWh_t, s.t10_percent, s.t10_resolved ? "" : " (unresolved)",
-      res.seconds);
+  return impact_line(j);
 }
 
 void BreakageStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& job_dir) {

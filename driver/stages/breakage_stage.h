@@ -17,12 +17,23 @@ class BreakageStage : public Stage {
   Plan plan(const StageContext& ctx) const override;
   void run_job(StageContext& ctx, const JobSpec& job, const std::filesystem::path& job_dir) override;
   void finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) override;
+  std::string damaged_outputs(const StageContext& ctx, const JobSpec& job) const override;
 
  private:
   // breakage/product.csv and product.json: the mill product per rotor speed
   // when the conditions came from the transport stage.
   void write_mill_product(StageContext& ctx, const std::vector<JobSpec>& jobs);
 };
+
+// The canonical inputs of one impact (the job id is their hash): case keys of
+// the lump and the run, the ore, the bond parameters, the condition.
+nlohmann::json impact_inputs(const StageContext& ctx, double velocity, double angle, int repeat);
+
+// The outputs run_impact writes into `dir` exist and parse: "" or the reason.
+std::string damaged_impact_outputs(const std::filesystem::path& dir);
+
+// The one-line summary of an impact from its result.json.
+std::string impact_line(const nlohmann::json& result);
 
 // One impact into `out_dir` (used by run_job and by `orchestrate impact`):
 // runs the deck, analyses the fragments, writes summary.csv, fractions.csv,

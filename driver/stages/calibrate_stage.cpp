@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "jobs/job_store.h"
+#include "jobs/output_checks.h"
 #include "progress.h"
 #include "stages/calibrate/fitting.h"
 #include "stages/calibrate/lab_runs.h"
@@ -198,6 +199,13 @@ void CalibrateStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pa
     return;
   }
   Calibration(ctx, job, job_dir).run();
+}
+
+// The job's calibrated.yaml (and, after a fit, report.json) exist and parse.
+std::string CalibrateStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
+  const fs::path dir = jobs::JobStore(ctx.stage_dir).job_dir(job.label);
+  return jobs::first_problem({jobs::check_yaml_map(dir / "calibrated.yaml"),
+                              job.inputs.contains("from_card") ? "" : jobs::check_json(dir / "report.json")});
 }
 
 // Publish the job's outputs as the stage's: calibrate/calibrated.yaml, reports, plots.

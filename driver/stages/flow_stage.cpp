@@ -17,6 +17,7 @@
 #include "engine/runner.h"
 #include "geometry/mill_geometry.h"
 #include "jobs/job_store.h"
+#include "jobs/output_checks.h"
 #include "progress.h"
 #include "stages/stage_util.h"
 
@@ -261,6 +262,8 @@ std::string case_parameters(const config::Document& doc, double rpm, const MeshP
                    g.axis_x, g.axis_height, rt);
   s += fmt::format("rotorRadius     {:.10g};\nrimRadius       {:.10g};\n", rr, rim);
   s += fmt::format("omega           {:.10g};  // rad/s = {:g} rpm\n", omega, rpm);
+  s += fmt::format("torqueCentre    {};  // on the axis, for the shaft torque\n",
+                   vec(g.axis_x, g.axis_height, 0.0));
   s += fmt::format("rimZ            {:.10g};\nrimStart        {};\n", rim_z,
                    vec(g.axis_x + rim, g.axis_height, rim_z));
   s += fmt::format("axisPoint1      {};\naxisPoint2      {};\n\n",
@@ -299,6 +302,9 @@ std::string case_parameters(const config::Document& doc, double rpm, const MeshP
       "rhoRef          {:.10g};\nnu              {:.10g};\nmu              {:.10g};\nTRef          "
       "  {:.10g};\n",
       rho, mu / rho, mu, doc.real("gas.temperature"));
+  // forces function object: rho from the field (rhoSimpleFoam) or rhoRef
+  // times the kinematic pressure (simpleFoam)
+  s += fmt::format("forcesRho       {};\n", comp ? "rho" : "rhoInf");
   if (comp) {
     s += "pDims           [1 -1 -2 0 0 0 0];  // Pa, absolute\n";
     s += fmt::format(
@@ -599,13 +605,24 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
                                   max_it, (out / "case" / ("log." + solver)).string()));
 }
 
+// The declared outputs of one rotor speed: report, solved case, geometry.
+std::string FlowStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
+  const fs::path out = flow::output_dir(ctx.run_dir, job.label);
+  std::vector<std::string> r = {jobs::check_json(out / "flow_report.json"), jobs::check_exists(out / "case" / "case.foam")};
+  for (const char* stl : {"housing.stl", "flywheel.stl", "inlet.stl", "outlet.stl"})
+    r.push_back(jobs::check_file(out / "geometry" / stl));
+  return jobs::first_problem(r);
+}
+
 // One summary of all rotor speeds: <run>/flow/flow_summary.json.
 void FlowStage::finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) {
   nlohmann::json all = nlohmann::json::array();
   for (const auto& j : jobs) {
     const fs::path f = flow::output_dir(ctx.run_dir, j.label) / "flow_report.json";
     if (!fs::exists(f)) continue;
-    nlohmann::json r = nlohmann::json::parse(flow::read_text(f));
+    nlohmann::json r = nlohmann::json::parse(flow::read_text(f), nullptr, false);
+    if (!r.is_object())
+      throw std::runtime_error(fmt::format("{}: not a JSON object (damaged?); rerun --stage flow --force", f.string()));
     r["label"] = j.label;
     all.push_back(r);
   }

@@ -27,6 +27,7 @@ class FlowStage : public Stage {
   void run_job(StageContext& ctx, const JobSpec& job,
                const std::filesystem::path& job_dir) override;
   void finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) override;
+  std::string damaged_outputs(const StageContext& ctx, const JobSpec& job) const override;
 };
 
 namespace flow {

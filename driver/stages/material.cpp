@@ -36,16 +36,22 @@ namespace {
 // Read calibrated.* from a YAML file if fitted to `hash`; false otherwise.
 bool read_calibrated(const fs::path& file, const std::string& hash, BondParams& b) {
   if (!fs::exists(file)) return false;
-  YAML::Node root = YAML::LoadFile(file.string());
-  YAML::Node c = root["calibrated"];
-  if (!c || !c["input_hash"] || c["input_hash"].as<std::string>() != hash) return false;
-  b.modulus = c["bond_modulus"].as<double>();
-  b.stiffness_ratio = c["stiffness_ratio"].as<double>();
-  b.tensile = c["bond_tensile_strength"].as<double>();
-  b.cohesion = c["bond_cohesion"].as<double>();
-  b.friction_angle_deg = c["bond_friction_angle"].as<double>();
-  // Absent from calibrations made before Nov 2026 (then always 1).
-  b.moment_factor = c["bond_moment_factor"] ? c["bond_moment_factor"].as<double>() : 1.0;
+  try {
+    YAML::Node root = YAML::LoadFile(file.string());
+    YAML::Node c = root.IsMap() ? root["calibrated"] : YAML::Node();
+    if (!c || !c.IsMap() || !c["input_hash"] || c["input_hash"].as<std::string>() != hash) return false;
+    b.modulus = c["bond_modulus"].as<double>();
+    b.stiffness_ratio = c["stiffness_ratio"].as<double>();
+    b.tensile = c["bond_tensile_strength"].as<double>();
+    b.cohesion = c["bond_cohesion"].as<double>();
+    b.friction_angle_deg = c["bond_friction_angle"].as<double>();
+    // Absent from calibrations made before Nov 2026 (then always 1).
+    b.moment_factor = c["bond_moment_factor"] ? c["bond_moment_factor"].as<double>() : 1.0;
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(fmt::format("{}: damaged calibration ({}); rerun `orchestrate --stage calibrate` (or "
+                                         "repair the file)",
+                                         file.string(), e.what()));
+  }
   b.origin = "calibrated (" + file.string() + ")";
   return true;
 }

@@ -6,11 +6,11 @@
 #include <sys/stat.h>
 
 #include <algorithm>
-#include <fstream>
 #include <sstream>
 
 #include "engine/runner.h"
 #include "jobs/job_store.h"
+#include "jobs/output_checks.h"
 #include "postprocess/breakage_results.h"
 #include "progress.h"
 #include "report/headline.h"
@@ -21,10 +21,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using report::cell;
 using report::embed_png;
 using report::esc;
 using report::fold;
 using report::json_table;
+using report::Problems;
 
 // Every file the report reads, under the stage folders it knows.
 std::vector<fs::path> report_inputs(const fs::path& run) {
@@ -92,7 +94,7 @@ void size_table(std::ostringstream& o, const nlohmann::json& sd) {
   if (!conds.is_array() || conds.empty()) return;
   const auto finest = report::pick(sd, "finest_sieve_mm");
   auto mm = [&](const nlohmann::json& v) {
-    if (v.is_number()) return fmt::format("{:.3g}", v.get<double>());
+    if (v.is_number()) return cell(v.get<double>(), "{:.3g}");
     return finest.is_number() ? fmt::format("&lt; {:.3g}", finest.get<double>()) : std::string("-");
   };
   o << "<table><tr><th>impact speed [m/s]</th><th>angle [deg]</th><th>repeats</th><th>P50 [mm]</th><th>P80 [mm]</th>"
@@ -126,11 +128,18 @@ Plan ReportStage::plan(const StageContext& ctx) const {
   return p;
 }
 
+// report/index.html (complete: it ends with </html>) and report/summary.json.
+std::string ReportStage::damaged_outputs(const StageContext& ctx, const JobSpec&) const {
+  return jobs::first_problem({jobs::check_text_ends(ctx.stage_dir / "index.html", "</html>"),
+                              jobs::check_json(ctx.stage_dir / "summary.json")});
+}
+
 void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
   const fs::path run = ctx.run_dir, out_dir = ctx.stage_dir;
   const auto inputs = report_inputs(run);
+  Problems problems;
   nlohmann::json summary = {
-      {"case", ctx.cfg.name}, {"ore", ctx.cfg.ore.str("name")}, {"headline", report::headline_json(run)}};
+      {"case", ctx.cfg.name}, {"ore", ctx.cfg.ore.str("name")}, {"headline", report::headline_json(run, &problems)}};
   const auto rows = report::headline_rows(summary["headline"]);
 
   // Figures drawn for the report from the flow stage's files: the mill
@@ -208,7 +217,8 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
                      [](const fs::path& a, const fs::path& b) { return figure_rank(a) < figure_rank(b); });
     for (const auto& f : pngs) embed_png(o, f, fs::relative(f, run).string());
     stage_numbers(o, rows, stage);
-    if (stage == "breakage") size_table(o, report::read_json(run / "breakage" / "size_distributions.json"));
+    if (stage == "breakage")
+      size_table(o, report::read_json(run / "breakage" / "size_distributions.json", &problems));
 
     std::ostringstream raw;
     std::string links;
@@ -216,10 +226,10 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
       const std::string rel = fs::relative(f, out_dir).string();
       const std::string name = fs::relative(f, run).string();
       if (f.extension() == ".json") {
-        nlohmann::json j;
-        try {
-          j = nlohmann::json::parse(report::slurp(f));
-        } catch (const std::exception&) {
+        const nlohmann::json j = report::read_json(f, &problems);
+        if (j.is_null()) {
+          o << "<p class=bad><code>" << esc(name) << "</code> not shown: this file is damaged (see the top of the "
+            << "page).</p>\n";
           continue;
         }
         raw << "<h3>" << esc(name) << "</h3>\n";
@@ -234,22 +244,51 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
       }
     }
     if (!links.empty()) o << "<p class=note>Data: " << links << "</p>\n";
+    std::vector<post::ImpactSummary> impacts;
     if (stage == "breakage" && fs::exists(run / "breakage" / "summary.csv")) {
-      const auto impacts = post::ReadSummaryCsv((run / "breakage" / "summary.csv").string());
+      try {
+        impacts = post::ReadSummaryCsv((run / "breakage" / "summary.csv").string());
+      } catch (const std::exception& e) {
+        problems.push_back({run / "breakage" / "summary.csv", e.what()});
+      }
+    }
+    if (!impacts.empty()) {
       raw << "<h3>Every impact</h3><table><tr><th>V [m/s]</th><th>angle [deg]</th><th>repeat</th><th>pieces</th>"
              "<th>single</th><th>multi</th><th>largest [%]</th><th>single mass [%]</th><th>broken bonds [%]</th>"
              "<th>Ecs [kWh/t]</th><th>t10 [%]</th></tr>\n";
       for (const auto& r : impacts)
         raw << fmt::format(
-            "<tr><td>{:g}</td><td>{:g}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.1f}</td>"
-            "<td>{:.1f}</td><td>{:.3g}</td><td>{:.1f}{}</td></tr>\n",
-            r.velocity_m_s, r.angle_deg, r.repeat, r.n_pieces, r.n_single, r.n_multi, 100 * r.largest_mass_fraction,
-            100 * r.single_mass_fraction, 100 * r.broken_bond_fraction, r.specific_energy_kWh_t, r.t10_percent,
-            r.t10_resolved ? "" : "*");
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>"
+            "<td>{}</td><td>{}</td><td>{}{}</td></tr>\n",
+            cell(r.velocity_m_s, "{:g}"), cell(r.angle_deg, "{:g}"), r.repeat, r.n_pieces, r.n_single, r.n_multi,
+            cell(r.largest_mass_fraction, "{:.1f}", 100), cell(r.single_mass_fraction, "{:.1f}", 100),
+            cell(r.broken_bond_fraction, "{:.1f}", 100), cell(r.specific_energy_kWh_t, "{:.3g}"),
+            cell(r.t10_percent, "{:.1f}"), r.t10_resolved ? "" : "*");
       raw << "</table><p class=note>* t10 not resolved: single elements are coarser than a tenth of the lump.</p>\n";
       summary["breakage_impacts"] = impacts.size();
     }
     if (!raw.str().empty()) o << fold("Raw results: every key of the stage's JSON files") << raw.str() << "</details>\n";
+  }
+  if (!problems.empty()) {
+    // Named at the top of the page, in summary.json and on the console.
+    std::ostringstream box;
+    box << "<div class=bad><b>Damaged input files, left out of this report:</b><ul>\n";
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& [f, why] : problems) {
+      const std::string rel = fs::relative(f, run).string();
+      box << "<li><code>" << esc(rel) << "</code>: " << esc(why) << "</li>\n";
+      list.push_back({{"file", rel}, {"problem", why}});
+      ctx.progress.warn(fmt::format("[report] {}: {}; left out of the report (rerun the stage that writes it, with "
+                                    "--force if its jobs are done)",
+                                    f.string(), why));
+    }
+    box << "</ul>Rerun the stage that writes each file (with <code>--force</code> if its jobs are done), then the "
+           "report.</div>\n";
+    summary["damaged_inputs"] = list;
+    std::string page = o.str();
+    page.insert(page.find("<h2>Headline</h2>"), box.str());
+    o.str(page);
+    o.seekp(0, std::ios::end);
   }
   o << report::page_tail();
   jobs::atomic_write(out_dir / "index.html", o.str());

@@ -12,6 +12,7 @@ class ReportStage : public Stage {
   std::string description() const override { return "the HTML report and headline numbers"; }
   Plan plan(const StageContext& ctx) const override;
   void run_job(StageContext& ctx, const JobSpec& job, const std::filesystem::path& job_dir) override;
+  std::string damaged_outputs(const StageContext& ctx, const JobSpec& job) const override;
 };
 
 }  // namespace mill

@@ -24,6 +24,7 @@
 
 #include "geometry/mill_geometry.h"
 #include "jobs/job_store.h"
+#include "jobs/output_checks.h"
 #include "progress.h"
 #include "stages/flow_stage.h"
 #include "stages/stage_util.h"
@@ -344,6 +345,13 @@ Plan SampleStage::plan(const StageContext& ctx) const {
   return p;
 }
 
+// sample/<label>/{field.h5, field.vti, midplane_speed.png, sample_report.json}.
+std::string SampleStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
+  const fs::path out = ctx.stage_dir / job.label;
+  return jobs::first_problem({jobs::check_json(out / "sample_report.json"), jobs::check_hdf5(out / "field.h5"),
+                              jobs::check_file(out / "field.vti"), jobs::check_file(out / "midplane_speed.png")});
+}
+
 // flow/<label>/case -> sample/<label>/{field.h5, field.vti, midplane_speed.png}.
 void SampleStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path&) {
   const auto& doc = ctx.cfg.doc;
@@ -359,10 +367,7 @@ void SampleStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path&
   grid.spacing = doc.real("sample.spacing");
   const double min_side = std::min({geo.width, geo.height, geo.depth});
   grid.wall_inset = 2e-3 * min_side;
-  if (grid.spacing > 0.5 * min_side)
-    throw std::invalid_argument(
-        fmt::format("{}: spacing {:g} m is too coarse for a {:g} m housing side (max {:g} m)",
-                    doc.where("sample.spacing"), grid.spacing, min_side, 0.5 * min_side));
+  // sample.spacing <= min_side / 2: checked with the case (config/case_config.cpp).
   sample::Options opt;
   opt.turbulence = doc.boolean("sample.turbulence");
   // Which part of the housing the flow stage solved: its report and its mesh

@@ -26,6 +26,7 @@ class SampleStage : public Stage {
   Plan plan(const StageContext& ctx) const override;
   void run_job(StageContext& ctx, const JobSpec& job,
                const std::filesystem::path& job_dir) override;
+  std::string damaged_outputs(const StageContext& ctx, const JobSpec& job) const override;
 };
 
 namespace sample {

@@ -76,6 +76,9 @@ class Stage {
   virtual void run_job(StageContext& ctx, const JobSpec& job, const std::filesystem::path& job_dir) = 0;
   // After every job is done: merge into the stage's declared outputs.
   virtual void finalize(StageContext& /*ctx*/, const std::vector<JobSpec>& /*jobs*/) {}
+  // A job is done only if its declared outputs exist and parse: "" when they
+  // do, else what is missing or damaged (the job is then run again).
+  virtual std::string damaged_outputs(const StageContext& /*ctx*/, const JobSpec& /*job*/) const { return ""; }
 };
 
 // The stages in pipeline order: flow, sample, transport, calibrate, breakage, report.

@@ -12,6 +12,7 @@
 #include "engine/liggghts.h"
 #include "geometry/mill_geometry.h"
 #include "jobs/job_store.h"
+#include "jobs/output_checks.h"
 #include "postprocess/flow_field_io.h"
 #include "postprocess/impact_stats.h"
 #include "progress.h"
@@ -25,7 +26,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;
-constexpr int kDeckVersion = 3;
+constexpr int kDeckVersion = 4;  // 4: fluid/drag checks the field's rotor speed (omega)
 
 // One lump of the injection schedule.
 struct Lump {
@@ -208,6 +209,21 @@ Plan TransportStage::plan(const StageContext& ctx) const {
   return p;
 }
 
+// transport/<label>/{impacts.csv, transport.h5, summary.json}: exist and read.
+std::string TransportStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
+  const fs::path out = ctx.stage_dir / job.label;
+  if (auto r = jobs::first_problem({jobs::check_json(out / "summary.json"), jobs::check_hdf5(out / "transport.h5"),
+                                    jobs::check_file(out / "impacts.csv")});
+      !r.empty())
+    return r;
+  try {
+    post::ReadImpactsCsv((out / "impacts.csv").string());
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
 // Runs the lumps through the mill at one rotor speed and writes the results
 // into transport/<label>/ (each file complete or absent).
 void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& job_dir) {
@@ -220,11 +236,8 @@ void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pa
         "stage transport ({}) needs {} (the sampled gas field at {:g} rpm); make it with "
         "`orchestrate --case {} --stage sample --output {}` (after --stage flow)",
         label, field_file.string(), rpm, d.file(), ctx.run_dir.string()));
+  // injection.time_limit > duration and the time step: checked with the case.
   const double duration = d.real("injection.duration"), t_limit = d.real("injection.time_limit");
-  if (!(t_limit > duration))
-    throw config::ConfigError(
-        fmt::format("{}: injection.time_limit ({:g} s) must exceed injection.duration ({:g} s)",
-                    d.where("injection.time_limit"), t_limit, duration));
   const geometry::MillGeometry g = geometry::MillGeometry::from_config(d);
   const double omega = rpm * 2 * kPi / 60.0;
   const long n = d.integer("injection.n_lumps");

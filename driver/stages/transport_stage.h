@@ -17,6 +17,7 @@ class TransportStage : public Stage {
   Plan plan(const StageContext& ctx) const override;
   void run_job(StageContext& ctx, const JobSpec& job,
                const std::filesystem::path& job_dir) override;
+  std::string damaged_outputs(const StageContext& ctx, const JobSpec& job) const override;
 };
 
 }  // namespace mill

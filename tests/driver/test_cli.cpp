@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -148,6 +149,23 @@ TEST(Cli, HpcRejectsUnknownScheduler) {
   auto o = orchestrate("hpc --scheduler pbs --stage breakage");
   EXPECT_EQ(o.status, 2);
   EXPECT_NE(o.text.find("--scheduler"), std::string::npos) << o.text;
+}
+
+// Valid Slurm values go into the #SBATCH lines as given; a run folder with
+// blanks is quoted there (sbatch splits #SBATCH lines on blanks).
+TEST(Cli, HpcWritesCheckedValuesAndQuotesPaths) {
+  const fs::path out = fs::temp_directory_path() / ("mill cli hpc spaces " + std::to_string(getpid()));
+  fs::remove_all(out);
+  auto o = orchestrate("hpc --stage breakage --case " + kData + "/good_small.yaml --time 1-12:30 --mem 4G --partition "
+                       "gpu,short --account proj_1 --max-parallel 2 --output '" + out.string() + "'");
+  ASSERT_EQ(o.status, 0) << o.text;
+  std::ifstream a(out / "hpc" / "breakage.array.sh");
+  const std::string array((std::istreambuf_iterator<char>(a)), std::istreambuf_iterator<char>());
+  for (const std::string& line : std::vector<std::string>{"#SBATCH --time=1-12:30\n", "#SBATCH --mem=4G\n", "#SBATCH --partition=gpu,short\n",
+                                 "#SBATCH --account=proj_1\n", "#SBATCH --array=0-3%2\n",
+                                 "#SBATCH --output=\"" + (out / "hpc" / "logs").string() + "/%x_%A_%a.out\"\n"})
+    EXPECT_NE(array.find(line), std::string::npos) << line << " not in:\n" << array;
+  fs::remove_all(out);
 }
 
 }  // namespace

@@ -68,6 +68,27 @@ TEST(Runner, EngineErrorLineFailsEvenWithExitZero) {
   EXPECT_NO_THROW(r.run(sh(d, "echo 'no error here'; exit 0", Engine::Liggghts)));
 }
 
+// LIGGGHTS warnings that invalidate a run fail it, with exit status 0 too:
+// dangerous neighbour builds (missed contacts) and lost atoms.
+TEST(Runner, DangerousBuildsAndLostAtomsFailTheRun) {
+  const auto d = fresh_dir("danger");
+  Runner r;
+  EXPECT_NO_THROW(r.run(sh(d, "echo 'Dangerous builds = 0'", Engine::Liggghts)));
+  for (const char* line : {"Dangerous builds = 12", "WARNING: Lost atoms: original 50 current 49"}) {
+    try {
+      r.run(sh(d, std::string("echo 'Neighbor list builds = 40'; echo '") + line + "'", Engine::Liggghts));
+      ADD_FAILURE() << "accepted a run whose log says: " << line;
+    } catch (const EngineError& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find(line), std::string::npos) << m;
+      EXPECT_NE(m.find("exit status 0, but the log has engine errors"), std::string::npos) << m;
+      EXPECT_NE(m.find("log.txt"), std::string::npos) << m;
+    }
+  }
+  // Other engines' logs may print the same words without meaning.
+  EXPECT_NO_THROW(r.run(sh(d, "echo 'Dangerous builds = 12'", Engine::Generic)));
+}
+
 TEST(Runner, MissingProgramIsAClearError) {
   const auto d = fresh_dir("missing");
   Command c = sh(d, "");

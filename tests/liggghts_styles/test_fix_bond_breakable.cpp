@@ -301,10 +301,14 @@ const char *kBurstFix =
 }  // namespace
 
 // Straight run vs a run split by write_restart / read_restart (the two halves
-// on np_first / np_second ranks); positions must agree within tol [m].
-void check_restart(int np_first, int np_second, double tol) {
-  const std::string dir =
-      make_run_dir("restart" + std::to_string(np_first) + std::to_string(np_second));
+// on np_first / np_second ranks); positions must agree within tol [m]. With
+// during_run the file is written by `restart 1000` inside a longer run (at the
+// end of step 1000, while the fix holds the bond history in its bond list),
+// not by write_restart between runs. (LIGGGHTS reneighbours on a restart step,
+// so the fix's pre_exchange has stored the history by then.)
+void check_restart(int np_first, int np_second, double tol, bool during_run = false) {
+  const std::string dir = make_run_dir("restart" + std::to_string(np_first) +
+                                       std::to_string(np_second) + (during_run ? "r" : ""));
   const std::string tail =
       "variable nb equal f_bonds[2]\nthermo_style custom step atoms f_bonds[1] f_bonds[2]\n"
       "thermo 500\n";
@@ -317,8 +321,11 @@ void check_restart(int np_first, int np_second, double tol) {
               "%.17g\"\n";
   first << head_split_x(0.05) << burst_setup() << "fix integr all nve/sphere\n"
         << kBurstFix << "timestep 5e-8\n"
-        << tail << "run 1000\nwrite_restart mid.restart\n";
-  second << "atom_modify map array\nread_restart mid.restart\nnewton off\n"
+        << tail
+        << (during_run ? "restart 1000 mid.restart\nrun 1500\n" : "run 1000\nwrite_restart mid.restart\n");
+  // `restart N file` appends the step to the file name.
+  second << "atom_modify map array\nread_restart " << (during_run ? "mid.restart.1000" : "mid.restart")
+         << "\nnewton off\n"
          << "communicate single vel yes\nneighbor 0.0002 bin\nneigh_modify delay 0\n"
          << "hard_particles yes\n"
          << "fix m1 all property/global youngsModulus peratomtype 5e9\n"
@@ -376,6 +383,10 @@ TEST(Restart, RestartedRunMatchesStraightRun) { check_restart(1, 1, 1e-12); }
 // Tolerance: equal counts, |dx| < 1e-9 m (summation order differs, contacts
 // amplify round-off).
 TEST(Restart, RestartAcrossRankCounts) { check_restart(2, 1, 1e-9); }
+
+// The restart file written during a run (periodic `restart`) holds the bond
+// history of that step. Tolerance: equal counts, |dx| < 1e-12 m.
+TEST(Restart, RestartWrittenDuringRunMatchesStraightRun) { check_restart(1, 1, 1e-12, true); }
 
 namespace {
 

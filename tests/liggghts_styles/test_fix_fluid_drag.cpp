@@ -173,3 +173,42 @@ TEST(FluidDrag, MissingViscosityIsNamed) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.screen.find("'viscosity'"), std::string::npos) << r.screen;
 }
+
+const char *kOneParticle =
+    "atom_modify sort 0 0.0\nneighbor 0.05 bin\ncreate_atoms 1 single 0 0 0 units box\n"
+    "set group all diameter 0.001 density 1000\n"
+    "fix integr all nve/sphere\n";
+
+// The field's rotor speed must be the deck's: `omega` (rad/s) is checked
+// against the rpm stored in the field file (relative tolerance 1e-4).
+TEST(FluidDrag, FieldRotorSpeedMustMatchDeckOmega) {
+  const std::string dir = make_run_dir("dragomega");
+  mill::post::FlowField f;
+  f.dims = {3, 3, 3};
+  f.origin = {-0.5, -0.5, -0.5};
+  f.spacing = {0.5, 0.5, 0.5};
+  f.allocate(false);
+  for (size_t p = 0; p < f.size(); ++p) {
+    f.mask[p] = 1;
+    f.rho[p] = kRhoGas;
+  }
+  f.rpm = 2000.0;
+  f.source = "test";
+  mill::post::write_flow_field(dir + "/field.h5", f);
+  auto deck = [&](const std::string &omega) {
+    return deck_head(0.6) + kOneParticle +
+           "fix drag all fluid/drag viscosity 1.8e-5 field field.h5 omega " +
+           omega + "\nrun 0\n";
+  };
+  const auto ok = run_deck(dir, deck("209.44"));  // 2000 rpm = 209.4395 rad/s
+  EXPECT_EQ(ok.exit_code, 0) << ok.screen;
+  const auto bad = run_deck(dir, deck("157.08"));  // 1500 rpm
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.screen.find("sampled at 2000 rpm"), std::string::npos) << bad.screen;
+  EXPECT_NE(bad.screen.find("deck's omega is 157.08 rad/s"), std::string::npos) << bad.screen;
+  const auto uni = run_deck(dir, deck_head(0.6) + kOneParticle +
+                                     "fix drag all fluid/drag viscosity 1.8e-5 uniform 0 0 0 1.2 "
+                                     "omega 10\nrun 0\n");
+  EXPECT_NE(uni.exit_code, 0);
+  EXPECT_NE(uni.screen.find("'omega'"), std::string::npos) << uni.screen;
+}
