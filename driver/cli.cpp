@@ -10,6 +10,7 @@
 #include <iostream>
 #include <regex>
 
+#include "compare.h"
 #include "config/case_config.h"
 #include "config/schema.h"
 #include "engine/runner.h"
@@ -41,6 +42,7 @@ Examples:
   orchestrate --stage breakage --task 7          run job 7 only (e.g. $SLURM_ARRAY_TASK_ID)
   orchestrate hpc --scheduler slurm --stage all  Slurm scripts chaining every stage (docs/hpc.md)
   orchestrate --print-schema > docs/config.md    every case-file and ore-card key
+  orchestrate compare runs/default runs/granite  headline numbers and product curves side by side
 
 A rerun of the same command resumes: done jobs whose inputs did not change are
 skipped; failed, interrupted and changed ones are rerun (--force redoes all).
@@ -160,6 +162,16 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
               "  sh runs/reference/hpc/submit_breakage.sh\n");
   hpc->fallthrough();
 
+  // orchestrate compare: several finished runs side by side.
+  std::vector<std::string> compare_runs;
+  CLI::App* compare = app.add_subcommand(
+      "compare", "One page (HTML) with the headline numbers and product curves of several finished runs side by side");
+  compare->add_option("runs", compare_runs, "Run folders (runs/<case>), at least two, each finished (report done)")
+      ->required();
+  compare->footer("\nExample:\n  orchestrate compare runs/default runs/granite --output runs/compare\n"
+                  "  (writes runs/compare/index.html; default --output: runs/compare)\n");
+  compare->fallthrough();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -192,6 +204,14 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
       opts.force = force;
       opts.np = np > 0 ? np : static_cast<int>(cfg.doc.integer("resources.np"));
       return run_single_impact(cfg, opts, imp_velocity, imp_angle, imp_repeat, out);
+    }
+    if (*compare) {
+      CompareOptions co;
+      for (const auto& r : compare_runs) co.runs.emplace_back(r);
+      co.output = fs::absolute(output.empty() ? fs::path("runs") / "compare" : fs::path(output));
+      co.project_dir = project_dir();
+      out << write_compare(co);
+      return 0;
     }
     const auto cfg = config::load_case(case_file, project_dir());
     if (*hpc) {

@@ -15,6 +15,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "postprocess/jk_fit.h"
 #include "postprocess/lammps_dump.h"
 
 namespace mill::post {
@@ -22,7 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kJoulePerKgPerKWhPerTonne = 3600.0;  // 1 kWh/t = 3.6e6 J / 1e3 kg
 constexpr const char* kFormat = "mill-breakage-1";
 
 // One summary column: name, unit, whether it is an integer, and accessors.
@@ -632,6 +632,48 @@ void MergeBreakageH5Files(const std::string& path, const std::vector<std::string
     throw;
   }
   fs::rename(tmp, path);
+}
+
+// The JK fits as /jk_fit/<name> groups of an existing file.
+void WriteJkFitH5(const std::string& path, const std::vector<JkFitRecord>& records) {
+  H5Quiet quiet;
+  const hid_t raw = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  if (raw < 0) throw PostError(fmt::format("{}: cannot open as HDF5 for writing", path));
+  H5Id file(raw, H5Fclose, "open");
+  if (H5Lexists(file, "jk_fit", H5P_DEFAULT) > 0) H5Check(H5Ldelete(file, "jk_fit", H5P_DEFAULT), "delete /jk_fit");
+  H5Id top(MakeGroup(file, "jk_fit"), H5Gclose, "group /jk_fit");
+  WriteStringAttr(top, "relation",
+                  "t10 = A (1 - exp(-b Ecs)), Ecs = V^2/2 in kWh/t (Napier-Munn et al. 1996, "
+                  "Mineral Comminution Circuits, JKMRC)");
+  for (const JkFitRecord& r : records) {
+    const std::size_t n = r.ecs_kwh_t.size();
+    if (r.t10_percent.size() != n || r.repeat.size() != n || r.used.size() != n) {
+      throw PostError(fmt::format("{}: /jk_fit/{}: point arrays differ in length", path, r.name));
+    }
+    H5Id g(MakeGroup(top, r.name), H5Gclose, fmt::format("group /jk_fit/{}", r.name));
+    WriteDataset(g, "ecs", r.ecs_kwh_t, {n}, "kWh/t");
+    WriteDataset(g, "t10", r.t10_percent, {n}, "%");
+    WriteDataset(g, "repeat", r.repeat, {n}, "1");
+    WriteDataset(g, "used", r.used, {n}, "1");
+    const JkFit& f = r.fit.pooled;
+    WriteStringAttr(g, "status", f.ok ? (f.note.empty() ? "fitted" : "fitted: " + f.note) : "not fitted: " + f.reason);
+    if (!f.ok) continue;
+    auto scalar = [&](const char* name, double v, const char* unit) { WriteDataset(g, name, std::vector<double>{v}, {1}, unit); };
+    scalar("A", f.a_percent, "%");
+    scalar("b", f.b_t_per_kwh, "t/kWh");
+    scalar("A_times_b", f.ab(), "% t/kWh");
+    scalar("A_se", f.a_se_percent, "%");
+    scalar("b_se", f.b_se_t_per_kwh, "t/kWh");
+    if (r.fit.a_percent) {
+      scalar("A_min", r.fit.a_percent->min, "%");
+      scalar("A_max", r.fit.a_percent->max, "%");
+      scalar("b_min", r.fit.b_t_per_kwh->min, "t/kWh");
+      scalar("b_max", r.fit.b_t_per_kwh->max, "t/kWh");
+      scalar("A_times_b_min", r.fit.ab->min, "% t/kWh");
+      scalar("A_times_b_max", r.fit.ab->max, "% t/kWh");
+    }
+    WriteNumberAttr(g, "repeats_fitted", r.fit.n_repeats_fitted, true);
+  }
 }
 
 }  // namespace mill::post

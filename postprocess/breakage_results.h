@@ -9,6 +9,7 @@
 
 #include "postprocess/distributions.h"
 #include "postprocess/fragments.h"
+#include "postprocess/jk_fit.h"
 
 namespace mill::post {
 
@@ -117,5 +118,21 @@ void WriteBreakageH5(const std::string& path, const std::vector<ImpactResult>& r
 // Merges per-impact breakage.h5 files into one: copies every /impacts group
 // and rebuilds /summary. Writes path.tmp, then renames.
 void MergeBreakageH5Files(const std::string& path, const std::vector<std::string>& inputs);
+
+// The JK fit of one group of impacts (one angle, or all conditions pooled),
+// with every point it considered: `used` is 1 where t10 was resolved.
+struct JkFitRecord {
+  std::string name;  // HDF5 group name, e.g. "a90" or "all"
+  std::vector<double> ecs_kwh_t, t10_percent;
+  std::vector<long long> repeat, used;
+  JkSweepFit fit;
+};
+
+// Adds /jk_fit/<name>/ to an existing breakage.h5 (the group is replaced if
+// present): datasets ecs (kWh/t), t10 (%), repeat, used, and, when the fit
+// succeeded, scalar datasets A (%), b (t/kWh), A_times_b, their standard
+// errors and, over repeats, A_min/A_max, b_min/b_max, A_times_b_min/_max.
+// Every dataset has a `unit` attribute; the group has `relation`.
+void WriteJkFitH5(const std::string& path, const std::vector<JkFitRecord>& records);
 
 }  // namespace mill::post

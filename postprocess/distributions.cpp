@@ -92,6 +92,49 @@ double T10Percent(const std::vector<double>& d_rel, const std::vector<double>& m
   return 100.0 * MassFractionFinerThan(d_rel, mass, 0.1);
 }
 
+// Running sum of the fraction masses, in percent.
+std::vector<double> CumulativePassingPercent(const std::vector<double>& fraction_mass) {
+  std::vector<double> out;
+  out.reserve(fraction_mass.size());
+  double sum = 0.0;
+  for (double m : fraction_mass) {
+    sum += m;
+    out.push_back(100.0 * sum);
+  }
+  return out;
+}
+
+// Pxx by log-linear interpolation between the two sieves around it.
+std::optional<double> SizeAtPercentPassing(const std::vector<double>& sieves,
+                                           const std::vector<double>& passing, double percent) {
+  if (sieves.size() != passing.size() || sieves.empty()) {
+    throw PostError(fmt::format("passing curve: {} sieves but {} passing values", sieves.size(),
+                                passing.size()));
+  }
+  for (std::size_t k = 0; k < sieves.size(); ++k) {
+    if (!(sieves[k] > 0.0) || (k > 0 && !(sieves[k] > sieves[k - 1]))) {
+      throw PostError(fmt::format(
+          "passing curve: sieve {} is {}; expected sizes > 0 in ascending order", k, sieves[k]));
+    }
+  }
+  // Percent passing is a running sum: a small dip from rounding is levelled.
+  double prev_p = 0.0;
+  for (std::size_t k = 0; k < sieves.size(); ++k) {
+    const double p = std::max(passing[k], prev_p);
+    if (p >= percent) {
+      if (k == 0) {
+        if (p == percent) return sieves[0];
+        return std::nullopt;  // finer than the finest sieve
+      }
+      const double t = (percent - prev_p) / (p - prev_p);
+      return std::exp(std::log(sieves[k - 1]) +
+                      t * (std::log(sieves[k]) - std::log(sieves[k - 1])));
+    }
+    prev_p = p;
+  }
+  return std::nullopt;
+}
+
 // First downward crossing of `threshold`, linearly interpolated.
 std::optional<double> FirstCrossingBelow(const std::vector<double>& velocity,
                                          const std::vector<double>& y, double threshold) {

@@ -29,6 +29,22 @@ double MassFractionFinerThan(const std::vector<double>& d_rel, const std::vector
 // t10: the mass percent of pieces finer than D/10, exact from the piece list.
 double T10Percent(const std::vector<double>& d_rel, const std::vector<double>& mass);
 
+// Cumulative mass percent passing each sieve, from the mass per size
+// fraction: fraction k holds sizes in [edges[k], edges[k+1]), so the sieve
+// at edges[k+1] passes fractions 0..k. Returns one value per fraction (the
+// sieves are edges[1..n]); the last is 100 when the masses sum to 1.
+std::vector<double> CumulativePassingPercent(const std::vector<double>& fraction_mass);
+
+// The size through which `percent` of the mass passes (P80 for 80), read off
+// a cumulative passing curve by interpolating log-linearly between sieves:
+// passing is taken as linear in log(size) between adjacent sieves (the usual
+// reading of a sieve analysis). `sieves` are sizes > 0 ascending, `passing`
+// the percent passing each. nullopt when even the finest sieve passes more
+// than `percent` (the answer is finer than the finest sieve) or the curve
+// never reaches it. Throws PostError on mismatched or unsorted input.
+std::optional<double> SizeAtPercentPassing(const std::vector<double>& sieves,
+                                           const std::vector<double>& passing, double percent);
+
 // The velocity where y(v) first falls below `threshold`, walking up in
 // velocity and interpolating linearly between the last point at or above it
 // and the first point below it. Points are sorted by velocity here; several

@@ -1,12 +1,15 @@
 #!/usr/bin/python3
 """Plots of a breakage sweep from its aggregated results.
 
-Reads only summary.csv and fractions.csv (written by postprocess/breakage_results)
+Reads only summary.csv (written by postprocess/breakage_results) and
+size_distributions.csv (written by the breakage stage)
 and writes, per impact angle, averaged over repeats with the min/max spread:
   pieces_vs_velocity.png      single-element and multi-element pieces vs speed
   largest_vs_velocity.png     largest piece mass fraction vs speed, with the
                               threshold and the critical velocity
-  mass_distribution.png       mass per size fraction at chosen speeds
+  passing_vs_size.png         cumulative % passing against size in mm (log
+                              axis) per condition, from size_distributions.csv
+                              (written by the breakage stage), with --passing
   critical_velocity.json      the speed where the largest piece fraction first
                               falls below the threshold (linear interpolation
                               between sweep points), of the repeat-averaged
@@ -15,7 +18,7 @@ and writes, per impact angle, averaged over repeats with the min/max spread:
 The critical velocity follows the same rule as FindCriticalVelocity in
 postprocess/distributions.h, so the driver and this script agree.
 
-Usage: plot_breakage.py --summary S --fractions F --out DIR
+Usage: plot_breakage.py --summary S --out DIR [--passing P]
                         [--threshold 0.05] [--velocities 20,100,150]
 """
 
@@ -32,12 +35,12 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 SUMMARY_NEEDED = ("velocity_m_s", "angle_deg", "repeat", "n_single", "n_multi",
                   "largest_mass_fraction")
-FRACTIONS_NEEDED = ("velocity_m_s", "angle_deg", "repeat", "fraction_index", "d_low_rel",
-                    "d_high_rel", "mass_fraction")
-
+PASSING_NEEDED = ("velocity_m_s", "angle_deg", "sieve_mm", "passing_percent", "passing_percent_min",
+                  "passing_percent_max")
 
 def read_csv(path, needed):
     """Reads a results CSV into a list of dicts of floats; exits naming a missing column."""
@@ -167,42 +170,36 @@ def plot_largest(by_angle, critical, threshold, path):
     save(fig, path)
 
 
-def plot_distribution(fractions, velocities, path):
-    """Mass per size fraction at chosen speeds (nearest in the sweep), mean and min/max."""
+def plot_passing(passing, velocities, path):
+    """Cumulative % passing against size in mm (log axis) per condition, the
+    repeat-averaged curve with its min-max band; P80 marked by a line."""
     fig, ax = plt.subplots(figsize=(8, 4.5))
-    available = sorted({r["velocity_m_s"] for r in fractions})
+    conds = sorted({(r["velocity_m_s"], r["angle_deg"]) for r in passing})
+    available = sorted({v for v, _ in conds})
     if velocities:
-        chosen = sorted({min(available, key=lambda a: abs(a - w)) for w in velocities})
-    else:
-        chosen = available
-    angles = sorted({r["angle_deg"] for r in fractions})
-    edges = {}
-    for r in fractions:
-        edges[int(r["fraction_index"])] = (r["d_low_rel"], r["d_high_rel"])
-    n = max(edges) + 1 if edges else 0
-    series = [(a, v) for a in angles for v in chosen]
-    width = 0.8 / max(1, len(series))
-    x = np.arange(n)
-    for s, (angle, vel) in enumerate(series):
-        per_repeat = defaultdict(lambda: np.zeros(n))
-        for r in fractions:
-            if r["angle_deg"] == angle and r["velocity_m_s"] == vel:
-                per_repeat[int(r["repeat"])][int(r["fraction_index"])] = r["mass_fraction"]
-        if not per_repeat:
-            continue
-        data = np.array(list(per_repeat.values()))
-        mean, lo, hi = data.mean(axis=0), data.min(axis=0), data.max(axis=0)
-        label = f"{vel:g} m/s" + (f", {angle_label(angle)}" if len(angles) > 1 else "")
-        ax.bar(x + (s - (len(series) - 1) / 2) * width, mean, width,
-               yerr=[mean - lo, hi - mean], capsize=2, label=label)
-    ax.set_xticks(x)
-    ax.set_xticklabels([f"{edges[k][0]:g}-{edges[k][1]:g}" for k in range(n)], rotation=45,
-                       ha="right", fontsize=8)
-    ax.set_xlabel("size fraction d/D [-]")
-    ax.set_ylabel("mass fraction [-]")
-    ax.set_title("Mass distribution over size fractions (mean, min-max over repeats)")
-    ax.grid(True, axis="y", alpha=0.3)
-    ax.legend(fontsize=8)
+        chosen = {min(available, key=lambda a: abs(a - w)) for w in velocities}
+        conds = [c for c in conds if c[0] in chosen]
+    angles = {a for _, a in conds}
+    cmap = plt.get_cmap("viridis")
+    for k, (vel, angle) in enumerate(conds):
+        rows = sorted((r for r in passing if r["velocity_m_s"] == vel and r["angle_deg"] == angle),
+                      key=lambda r: r["sieve_mm"])
+        size = np.array([r["sieve_mm"] for r in rows])
+        colour = cmap(k / max(1, len(conds) - 1) * 0.9)
+        label = f"{vel:g} m/s" + (f", {angle:g} deg" if len(angles) > 1 else "")
+        ax.semilogx(size, [r["passing_percent"] for r in rows], "o-", ms=3, color=colour, label=label)
+        ax.fill_between(size, [r["passing_percent_min"] for r in rows], [r["passing_percent_max"] for r in rows],
+                        color=colour, alpha=0.15, lw=0)
+    ax.axhline(80, color="k", ls=":", lw=0.8)
+    ax.axhline(50, color="k", ls=":", lw=0.8)
+    ax.set_xlabel("size [mm] (sieve: upper edge of each size fraction)")
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:g}"))
+    ax.xaxis.set_minor_formatter(FuncFormatter(lambda x, _: f"{x:g}" if str(x)[0] in "25" else ""))
+    ax.set_ylabel("cumulative mass % passing")
+    ax.set_ylim(0, 102)
+    ax.set_title("Size distribution per impact condition (band: min-max over repeats)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8, ncol=2 if len(conds) > 8 else 1)
     save(fig, path)
 
 
@@ -220,11 +217,11 @@ def main(argv=None):
     """Reads the CSVs, writes the PNGs and critical_velocity.json into --out."""
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--summary", required=True, help="summary.csv")
-    p.add_argument("--fractions", required=True, help="fractions.csv")
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--threshold", type=float, default=0.05,
                    help="largest piece fraction below which the lump counts as shattered")
-    p.add_argument("--velocities", default="", help="speeds for the distribution plot, m/s")
+    p.add_argument("--passing", default="", help="size_distributions.csv: draw passing_vs_size.png")
+    p.add_argument("--velocities", default="", help="speeds for the passing plot, m/s (default: all)")
     p.add_argument("--pool-angles", action="store_true",
                    help="one curve over all rows (conditions binned from transport: each bin has its own "
                         "speed and angle, so per-angle curves would have one point each)")
@@ -233,7 +230,6 @@ def main(argv=None):
         sys.exit(f"--threshold: expected a fraction in (0, 1), got {a.threshold}")
 
     summary = read_csv(a.summary, SUMMARY_NEEDED)
-    fractions = read_csv(a.fractions, FRACTIONS_NEEDED)
     if not summary:
         sys.exit(f"{a.summary}: no rows")
     os.makedirs(a.out, exist_ok=True)
@@ -245,8 +241,15 @@ def main(argv=None):
 
     plot_pieces(by_angle, os.path.join(a.out, "pieces_vs_velocity.png"))
     plot_largest(by_angle, critical, a.threshold, os.path.join(a.out, "largest_vs_velocity.png"))
-    plot_distribution(fractions, parse_velocities(a.velocities),
-                      os.path.join(a.out, "mass_distribution.png"))
+    if a.passing:
+        passing = read_csv(a.passing, PASSING_NEEDED)
+        if not passing:
+            sys.exit(f"{a.passing}: no rows")
+        plot_passing(passing, parse_velocities(a.velocities), os.path.join(a.out, "passing_vs_size.png"))
+    # The superseded bar chart of mass per fraction, if an older run left one.
+    old = os.path.join(a.out, "mass_distribution.png")
+    if os.path.exists(old):
+        os.remove(old)
 
     out = {"threshold": a.threshold,
            "quantity": "largest_mass_fraction",

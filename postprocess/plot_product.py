@@ -3,12 +3,15 @@
 
 product.json (written by the breakage stage when its conditions come from the
 transport stage) holds, per rotor speed, the product of one pass: the mass per
-size fraction of relative piece size d/D, the fully shredded (single-element)
-mass share, the largest piece and t10. This draws product_vs_rpm.png:
+size fraction, the cumulative % passing each sieve (mm) with P50 and P80, the
+fully shredded (single-element) mass share, the largest piece and t10. This
+draws product_vs_rpm.png:
 
-  left   fully shredded mass %, largest piece % and t10 % against rpm: where
-         these flatten, the rotor speed can be lowered for the same product
-  right  the cumulative product distribution (mass % finer than d/D) per rpm
+  left    P80 and P50 of the product [mm] against rpm (a point finer than the
+          finest sieve is drawn at that sieve, hollow)
+  middle  fully shredded mass %, largest piece % and t10 % against rpm: where
+          these flatten, the rotor speed can be lowered for the same product
+  right   the product's cumulative % passing against size [mm], log axis, per rpm
 
 Usage: plot_product.py --product breakage/product.json --out breakage/plots
 """
@@ -23,9 +26,10 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 NEEDED = ("rpm", "fraction_edges_rel", "fraction_mass", "fully_shredded_mass_fraction",
-          "largest_piece_mass_fraction", "t10_percent")
+          "largest_piece_mass_fraction", "t10_percent", "sieves_mm", "passing_percent", "p50_mm", "p80_mm")
 
 
 def read_product(path):
@@ -45,6 +49,8 @@ def read_product(path):
         if len(e["fraction_edges_rel"]) != len(e["fraction_mass"]) + 1:
             sys.exit(f"{path}: entry {i}: {len(e['fraction_edges_rel'])} edges for "
                      f"{len(e['fraction_mass'])} fractions")
+        if len(e["sieves_mm"]) != len(e["passing_percent"]):
+            sys.exit(f"{path}: entry {i}: {len(e['sieves_mm'])} sieves for {len(e['passing_percent'])} passing values")
     return sorted(data, key=lambda e: e["rpm"])
 
 
@@ -57,7 +63,21 @@ def main(argv=None):
     os.makedirs(a.out, exist_ok=True)
 
     rpm = np.array([e["rpm"] for e in data])
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.3))
+    fig, (ax0, ax1, ax2) = plt.subplots(1, 3, figsize=(14, 4.3))
+    for key, label, style in (("p80_mm", "P80", "o-"), ("p50_mm", "P50", "s--")):
+        ys = [e[key] if e[key] is not None else e["sieves_mm"][0] for e in data]
+        line, = ax0.plot(rpm, ys, style, label=label)
+        below = [(r, y) for r, y, e in zip(rpm, ys, data) if e[key] is None]
+        if below:
+            ax0.plot([b[0] for b in below], [b[1] for b in below], "o", mfc="white", color=line.get_color(),
+                     label=f"{label} finer than the finest sieve")
+    ax0.set_xlabel("rotor speed [rpm]")
+    ax0.set_ylabel("size [mm]")
+    ax0.set_ylim(bottom=0)
+    ax0.set_title("Product size: P80 and P50")
+    ax0.legend(fontsize=8)
+    ax0.grid(alpha=0.3)
+
     for key, label, scale in (("fully_shredded_mass_fraction", "fully shredded mass", 100),
                               ("largest_piece_mass_fraction", "largest piece", 100),
                               ("t10_percent", "t10 (finer than D/10)", 1)):
@@ -65,22 +85,24 @@ def main(argv=None):
     ax1.set_xlabel("rotor speed [rpm]")
     ax1.set_ylabel("% of the feed mass")
     ax1.set_ylim(-2, 102)
-    if len(rpm) == 1:
-        ax1.set_xlim(rpm[0] * 0.8, rpm[0] * 1.2)
+    for ax in (ax0, ax1):
+        if len(rpm) == 1:
+            ax.set_xlim(rpm[0] * 0.8, rpm[0] * 1.2)
     ax1.set_title("One pass through the mill")
     ax1.legend(fontsize=8)
     ax1.grid(alpha=0.3)
 
     for e in data:
-        edges = np.array(e["fraction_edges_rel"])
-        cum = np.concatenate([[0.0], np.cumsum(e["fraction_mass"])]) * 100
-        ax2.plot(edges, cum, "o-", ms=3, label=f"{e['rpm']:g} rpm")
-    ax2.set_xlabel("relative piece size d/D")
-    ax2.set_ylabel("mass % finer than d/D")
-    ax2.set_ylim(-2, 102)
+        ax2.semilogx(e["sieves_mm"], e["passing_percent"], "o-", ms=3, label=f"{e['rpm']:g} rpm")
+    ax2.axhline(80, color="k", ls=":", lw=0.8)
+    ax2.set_xlabel("size [mm]")
+    ax2.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:g}"))
+    ax2.xaxis.set_minor_formatter(FuncFormatter(lambda x, _: f"{x:g}" if str(x)[0] in "25" else ""))
+    ax2.set_ylabel("cumulative mass % passing")
+    ax2.set_ylim(0, 102)
     ax2.set_title("Product size distribution")
     ax2.legend(fontsize=8)
-    ax2.grid(alpha=0.3)
+    ax2.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
     path = os.path.join(a.out, "product_vs_rpm.png")
     fig.savefig(path + ".tmp", dpi=110, format="png")

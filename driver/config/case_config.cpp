@@ -347,6 +347,10 @@ void check_ore(const Document& ore) {
   if (ore.real("ucs") <= ore.real("tensile_strength"))
     throw ConfigError(fmt::format("{}: expected ucs > tensile_strength (rocks: ucs/tensile ~ 5-20), got ucs {:g} Pa <= {:g} Pa",
                                   ore.where("ucs"), ore.real("ucs"), ore.real("tensile_strength")));
+  for (const auto& [given, other] : {std::pair<const char*, const char*>{"jk.A", "jk.b"}, {"jk.b", "jk.A"}})
+    if (ore.has(given) && !ore.has(other))
+      throw ConfigError(fmt::format("{}: {} is given without {}: a measured JK pair needs both (or remove {})",
+                                    ore.where(given), given, other, given));
   if (ore.real("youngs_modulus") < 1e6)
     throw ConfigError(fmt::format("{}: expected Young's modulus in Pa (rock: 1e9-1e11), got {:g}; did you give GPa?",
                                   ore.where("youngs_modulus"), ore.real("youngs_modulus")));

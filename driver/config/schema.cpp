@@ -226,6 +226,11 @@ Schema make_ore_schema() {
       positive(key("tensile_strength", T::Real, "Pa", "", "Tensile strength (Brazilian)")),
       at_least(key("friction", T::Real, "", "0.5", "Coulomb friction coefficient (element-element and walls)"), 0),
       range(key("restitution", T::Real, "", "0.5", "Coefficient of restitution"), 0, true, 1, false),
+      // Measured JK drop-weight parameters (Napier-Munn et al. 1996), optional:
+      // drawn against the breakage sweep's own fit; they change no simulation.
+      opt(range(key("jk.A", T::Real, "%", "", "Measured JK breakage parameter A: the largest t10 of the ore (drop-weight test); give with jk.b"), 0, true, 100, false)),
+      opt(range(key("jk.b", T::Real, "t/kWh", "", "Measured JK breakage parameter b (t10 = A (1 - exp(-b Ecs)), Ecs in kWh/t); give with jk.A"), 0, true, 100, false)),
+      opt(key("jk.source", T::String, "", "", "Where the measured A and b come from (laboratory, report)")),
       // Calibrated micro parameters: written by `--stage calibrate`, optional.
       opt(positive(key("calibrated.bond_modulus", T::Real, "Pa", "", "Bond modulus E_b (k_n = E_b / L)"))),
       opt(positive(key("calibrated.stiffness_ratio", T::Real, "", "", "Bond normal/shear stiffness ratio"))),

@@ -28,6 +28,7 @@
 #include "postprocess/impact_stats.h"
 #include "postprocess/lammps_dump.h"
 #include "progress.h"
+#include "stages/breakage_summaries.h"
 #include "stages/lump_builder.h"
 #include "stages/material.h"
 #include "stages/stage_util.h"
@@ -362,13 +363,16 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& jobs
   const jobs::JobStore store(dir);
   std::vector<std::string> h5;
   std::vector<post::ImpactSummary> rows;
+  std::vector<post::FractionRow> fraction_rows;
   std::string fractions_text;
   for (const auto& j : jobs) {
     const fs::path jd = store.job_dir(j.label);
     h5.push_back((jd / "impact.h5").string());
     for (const auto& s : post::ReadSummaryCsv((jd / "summary.csv").string())) rows.push_back(s);
-    for (const auto& f : post::ReadFractionsCsv((jd / "fractions.csv").string()))
+    for (const auto& f : post::ReadFractionsCsv((jd / "fractions.csv").string())) {
       fractions_text += post::FractionsCsvLine(f) + "\n";
+      fraction_rows.push_back(f);
+    }
   }
   std::string header;
   for (const auto& c : post::FractionsCsvColumns()) header += (header.empty() ? "" : ",") + c;
@@ -412,10 +416,14 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& jobs
   }
   jobs::atomic_write(dir / "critical_velocity.json", crit.dump(2) + "\n");
 
+  // In the mill engineer's terms: JK A and b, passing curves in mm.
+  write_size_distributions(ctx, fraction_rows);
+  write_jk_fit(ctx, rows, pooled);
+
   // Plots from the merged CSVs (matplotlib, Debian's python3).
   engine::Command c;
   c.argv = {"/usr/bin/python3", (ctx.cfg.project_dir / "postprocess" / "plot_breakage.py").string(),
-            "--summary", (dir / "summary.csv").string(), "--fractions", (dir / "fractions.csv").string(),
+            "--summary", (dir / "summary.csv").string(), "--passing", (dir / "size_distributions.csv").string(),
             "--out", (dir / "plots").string(), "--threshold", num(thr)};
   if (pooled) c.argv.push_back("--pool-angles");
   c.cwd = dir;
@@ -423,7 +431,9 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& jobs
   c.job = "breakage/plots";
   ctx.runner.run(c);
   if (ctx.cfg.doc.str("breakage.conditions") == "transport") write_mill_product(ctx, jobs);
-  ctx.progress.info(fmt::format("[breakage] results: {}/summary.csv, fractions.csv, breakage.h5, plots/*.png", dir.string()));
+  ctx.progress.info(fmt::format(
+      "[breakage] results: {}/summary.csv, fractions.csv, size_distributions.csv, jk_fit.json, breakage.h5, plots/*.png",
+      dir.string()));
 }
 
 void BreakageStage::write_mill_product(StageContext& ctx, const std::vector<JobSpec>& jobs) {
@@ -458,7 +468,9 @@ void BreakageStage::write_mill_product(StageContext& ctx, const std::vector<JobS
     ++a.n;
   }
   nlohmann::json out = nlohmann::json::array();
-  std::string csv = "rpm,fraction_index,d_low_rel,d_high_rel,mass_fraction\n";
+  const double d_mm = 1000 * ctx.cfg.doc.real("lump.diameter");
+  const auto sieves = sieves_mm(edges, d_mm);
+  std::string csv = "rpm,fraction_index,d_low_rel,d_high_rel,mass_fraction,d_high_mm,passing_percent\n";
   for (auto& [rpm, bins] : by_rpm) {
     std::vector<post::ConditionBreakage> conds;
     for (auto& [bin, a] : bins) {
@@ -469,19 +481,28 @@ void BreakageStage::write_mill_product(StageContext& ctx, const std::vector<JobS
       conds.push_back(a.c);
     }
     const auto prod = post::CombineProduct(conds);
+    const nlohmann::json pass = passing_json(sieves, prod.fraction_mass);
     for (size_t k = 0; k < prod.fraction_mass.size(); ++k)
-      csv += fmt::format("{:g},{},{:g},{:g},{:.9g}\n", rpm, k, edges[k], edges[k + 1], prod.fraction_mass[k]);
-    out.push_back({{"rpm", rpm},
-                   {"conditions", conds.size()},
-                   {"fraction_edges_rel", edges},
-                   {"fraction_mass", prod.fraction_mass},
-                   {"fully_shredded_mass_fraction", prod.single_mass_fraction},
-                   {"largest_piece_mass_fraction", prod.largest_mass_fraction},
-                   {"t10_percent", prod.t10_percent}});
-    ctx.progress.info(fmt::format("[breakage] mill product at {:g} rpm ({} conditions): fully shredded {:.1f}% of the mass, "
-                                  "largest piece {:.1f}%, t10 {:.1f}%",
-                                  rpm, conds.size(), 100 * prod.single_mass_fraction, 100 * prod.largest_mass_fraction,
-                                  prod.t10_percent));
+      csv += fmt::format("{:g},{},{:g},{:g},{:.9g},{:.6g},{:.6g}\n", rpm, k, edges[k], edges[k + 1], prod.fraction_mass[k],
+                         sieves[k], pass["passing_percent"][k].get<double>());
+    nlohmann::json e = {{"rpm", rpm},
+                        {"conditions", conds.size()},
+                        {"fraction_edges_rel", edges},
+                        {"fraction_mass", prod.fraction_mass},
+                        {"fully_shredded_mass_fraction", prod.single_mass_fraction},
+                        {"largest_piece_mass_fraction", prod.largest_mass_fraction},
+                        {"t10_percent", prod.t10_percent},
+                        {"lump_diameter_mm", d_mm}};
+    e.update(pass);
+    out.push_back(e);
+    const auto mm = [&](const char* k) {
+      return pass[k].is_number() ? fmt::format("{:.3g} mm", pass[k].get<double>())
+                                 : fmt::format("< {:.3g} mm", sieves.front());
+    };
+    ctx.progress.info(fmt::format("[breakage] mill product at {:g} rpm ({} conditions): P80 {}, P50 {}, fully shredded "
+                                  "{:.1f}% of the mass, largest piece {:.1f}%, t10 {:.1f}%",
+                                  rpm, conds.size(), mm("p80_mm"), mm("p50_mm"), 100 * prod.single_mass_fraction,
+                                  100 * prod.largest_mass_fraction, prod.t10_percent));
   }
   jobs::atomic_write(dir / "product.csv", csv);
   jobs::atomic_write(dir / "product.json", out.dump(2) + "\n");

@@ -6,8 +6,6 @@
 #include <sys/stat.h>
 
 #include <algorithm>
-#include <cmath>
-#include <fstream>
 #include <sstream>
 
 #include "engine/runner.h"
@@ -15,62 +13,20 @@
 #include "jobs/output_checks.h"
 #include "postprocess/breakage_results.h"
 #include "progress.h"
+#include "report/headline.h"
+#include "report/html.h"
 
 namespace mill {
 namespace fs = std::filesystem;
 
 namespace {
 
-std::string slurp(const fs::path& f) {
-  std::ifstream in(f, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
-std::string base64(const std::string& in) {
-  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  size_t i = 0;
-  for (; i + 2 < in.size(); i += 3) {
-    const unsigned n = (static_cast<unsigned char>(in[i]) << 16) | (static_cast<unsigned char>(in[i + 1]) << 8) |
-                       static_cast<unsigned char>(in[i + 2]);
-    out += {t[n >> 18], t[(n >> 12) & 63], t[(n >> 6) & 63], t[n & 63]};
-  }
-  if (i + 1 == in.size()) {
-    const unsigned n = static_cast<unsigned char>(in[i]) << 16;
-    out += {t[n >> 18], t[(n >> 12) & 63], '=', '='};
-  } else if (i + 2 == in.size()) {
-    const unsigned n = (static_cast<unsigned char>(in[i]) << 16) | (static_cast<unsigned char>(in[i + 1]) << 8);
-    out += {t[n >> 18], t[(n >> 12) & 63], t[(n >> 6) & 63], '='};
-  }
-  return out;
-}
-
-std::string esc(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else if (c == '"') o += "&quot;";
-    else o += c;
-  }
-  return o;
-}
-
-// A number for a table cell with the given precision ("{:.1f}"); a value
-// that is not a number (NaN, infinite: a damaged or degenerate result) reads
-// "n/a", never as a huge integer.
-std::string cell(double v, const char* spec, double scale = 1.0) {
-  if (!std::isfinite(v)) return "n/a";
-  return fmt::format(fmt::runtime(spec), scale * v);
-}
-
-std::string fmt_value(const nlohmann::json& v) {
-  if (v.is_number_float()) return cell(v.get<double>(), "{:.4g}");
-  if (v.is_string()) return esc(v.get<std::string>());
-  if (v.is_null()) return "n/a";
-  return esc(v.dump());
-}
+using report::cell;
+using report::embed_png;
+using report::esc;
+using report::fold;
+using report::json_table;
+using report::Problems;
 
 // Every file the report reads, under the stage folders it knows.
 std::vector<fs::path> report_inputs(const fs::path& run) {
@@ -94,101 +50,65 @@ std::vector<fs::path> report_inputs(const fs::path& run) {
   return files;
 }
 
-// A JSON object as a two-column table (nested objects flattened with dots).
-void json_table(std::ostringstream& o, const nlohmann::json& j, const std::string& prefix = "") {
-  if (prefix.empty()) o << "<table>\n";
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
-    if (it->is_object()) json_table(o, *it, key);
-    else o << "<tr><td>" << esc(key) << "</td><td>" << fmt_value(*it) << "</td></tr>\n";
-  }
-  if (prefix.empty()) o << "</table>\n";
+// The stage's figures first in the order an engineer reads them, then the rest.
+int figure_rank(const fs::path& f) {
+  static const std::vector<std::string> first = {"jk_t10_vs_ecs.png", "passing_vs_size.png", "product_vs_rpm.png",
+                                                 "largest_vs_velocity.png", "pieces_vs_velocity.png"};
+  const auto it = std::find(first.begin(), first.end(), f.filename().string());
+  return it == first.end() ? static_cast<int>(first.size()) : static_cast<int>(it - first.begin());
 }
 
-// Input files the report could not read, with the reason: shown at the top
-// of the report and printed as warnings, never silently left out.
-using Problems = std::vector<std::pair<fs::path, std::string>>;
-
-// A JSON file, or null when it does not exist; one that does not parse is
-// null too and goes into `problems`.
-nlohmann::json read_json(const fs::path& f, Problems& problems) {
-  if (!fs::exists(f)) return nullptr;
-  try {
-    return nlohmann::json::parse(slurp(f));
-  } catch (const std::exception& e) {
-    if (std::none_of(problems.begin(), problems.end(), [&](const auto& p) { return p.first == f; }))
-      problems.push_back({f, fmt::format("not valid JSON ({})", e.what())});
-    return nullptr;
+// The headline rows of the stage's groups as a labelled list (dt/dd).
+void stage_numbers(std::ostringstream& o, const std::vector<report::HeadlineRow>& rows, const std::string& stage) {
+  std::string items;
+  for (const auto& g : report::headline_groups()) {
+    if (g.stage != stage) continue;
+    for (const auto& r : rows)
+      if (r.group == g.title) items += "<dt>" + esc(r.what) + "</dt><dd>" + esc(r.value) + "</dd>\n";
   }
+  if (!items.empty()) o << "<dl class=numbers>\n" << items << "</dl>\n";
 }
 
-// v[key] or null.
-nlohmann::json pick(const nlohmann::json& v, const char* key) {
-  return v.is_object() && v.contains(key) ? v.at(key) : nlohmann::json(nullptr);
+// The ore card's properties in words and units.
+void ore_table(std::ostringstream& o, const config::Document& ore) {
+  o << "<table class=headline>\n";
+  auto row = [&](const std::string& what, const std::string& value) {
+    o << "<tr><td>" << esc(what) << "</td><td>" << esc(value) << "</td></tr>\n";
+  };
+  row("ore", ore.str("name"));
+  row("density", fmt::format("{:g} kg/m3", ore.real("density")));
+  row("Young's modulus", fmt::format("{:.3g} GPa", ore.real("youngs_modulus") / 1e9));
+  row("Poisson's ratio", fmt::format("{:g}", ore.real("poisson_ratio")));
+  row("uniaxial compressive strength (UCS)", fmt::format("{:.3g} MPa", ore.real("ucs") / 1e6));
+  row("tensile strength", fmt::format("{:.3g} MPa", ore.real("tensile_strength") / 1e6));
+  if (ore.has("jk.A") && ore.has("jk.b"))
+    row("JK breakage parameters (measured)",
+        fmt::format("A {:g}%, b {:g} t/kWh, A x b {:.3g}", ore.real("jk.A"), ore.real("jk.b"),
+                    ore.real("jk.A") * ore.real("jk.b")));
+  o << "</table>\n";
 }
 
-void embed_png(std::ostringstream& o, const fs::path& f, const std::string& caption) {
-  o << "<figure><img alt=\"" << esc(caption) << "\" src=\"data:image/png;base64," << base64(slurp(f))
-    << "\"><figcaption>" << esc(caption) << "</figcaption></figure>\n";
-}
-
-// The numbers an engineer looks at first, per stage (and per rotor speed).
-nlohmann::json headline(const fs::path& run, Problems& problems) {
-  nlohmann::json h = nlohmann::json::object();
-  for (const auto& d : {run / "flow", run / "transport"}) {
-    if (!fs::is_directory(d)) continue;
-    for (const auto& e : fs::directory_iterator(d)) {
-      const std::string rpm = e.path().filename().string();
-      if (!e.is_directory() || rpm.rfind("rpm", 0) != 0) continue;
-      if (d.filename() == "flow") {
-        const auto f = read_json(e.path() / "flow_report.json", problems);
-        if (f.is_null()) continue;
-        h["flow"][rpm] = {{"domain", pick(f, "domain")},
-                          {"cells", pick(f, "cells")},
-                          {"iterations", pick(f, "iterations")},
-                          {"converged", pick(f, "converged")},
-                          {"mass_imbalance_relative", pick(pick(f, "mass_flow_kg_s"), "imbalance_relative")},
-                          {"inlet_mass_flow_kg_s", pick(pick(f, "mass_flow_kg_s"), "inlet_in")},
-                          {"rim_gas_speed_to_tip_speed", pick(pick(f, "rim"), "ratio_speed_to_tip_speed")},
-                          {"shaft_torque_Nm", pick(pick(f, "shaft"), "torque_Nm")},
-                          {"shaft_power_kW", pick(pick(f, "shaft"), "power_kW")},
-                          {"backflow_outlet_in_kg_s", pick(pick(f, "backflow_kg_s"), "outlet_in")},
-                          {"backflow_inlet_out_kg_s", pick(pick(f, "backflow_kg_s"), "inlet_out")}};
-      } else {
-        const auto t = read_json(e.path() / "summary.json", problems);
-        if (t.is_null()) continue;
-        h["transport"][rpm] = {{"lumps", pick(t, "n_particles")},
-                               {"flywheel_impacts", pick(t, "n_flywheel_impacts")},
-                               {"wall_impacts", pick(t, "n_wall_impacts")},
-                               {"flywheel_impact_speed_mean_m_s", pick(t, "flywheel_impact_speed_mean_m_s")},
-                               {"flywheel_normal_speed_mean_m_s", pick(t, "flywheel_normal_speed_mean_m_s")},
-                               {"flywheel_angle_mean_deg", pick(t, "flywheel_angle_mean_deg")}};
-      }
-    }
+// P50 and P80 per impact condition, from breakage/size_distributions.json.
+void size_table(std::ostringstream& o, const nlohmann::json& sd) {
+  const auto conds = report::pick(sd, "conditions");
+  if (!conds.is_array() || conds.empty()) return;
+  const auto finest = report::pick(sd, "finest_sieve_mm");
+  auto mm = [&](const nlohmann::json& v) {
+    if (v.is_number()) return cell(v.get<double>(), "{:.3g}");
+    return finest.is_number() ? fmt::format("&lt; {:.3g}", finest.get<double>()) : std::string("-");
+  };
+  o << "<table><tr><th>impact speed [m/s]</th><th>angle [deg]</th><th>repeats</th><th>P50 [mm]</th><th>P80 [mm]</th>"
+       "<th>P80 over repeats [mm]</th></tr>\n";
+  for (const auto& c : conds) {
+    const auto r = report::pick(c, "p80_mm_over_repeats");
+    o << fmt::format("<tr><td>{:g}</td><td>{:g}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+                     c.value("velocity_m_s", 0.0), c.value("angle_deg", 0.0), c.value("repeats", 0),
+                     mm(report::pick(c, "p50_mm")), mm(report::pick(c, "p80_mm")),
+                     r.is_object() ? fmt::format("{:.3g}-{:.3g}", r.value("min", 0.0), r.value("max", 0.0)) : "-");
   }
-  const auto cal = read_json(run / "calibrate" / "report.json", problems);
-  if (!cal.is_null())
-    h["calibration"] = {{"source", pick(cal, "source")}, {"converged", pick(cal, "converged")},
-                        {"achieved", pick(cal, "achieved")}};
-  const auto crit = read_json(run / "breakage" / "critical_velocity.json", problems);
-  if (crit.is_array()) {
-    for (const auto& c : crit) {
-      const auto angle = pick(c, "angle_deg");
-      h["breakage"]["critical_velocity_m_s"][angle.is_number() ? fmt::format("{:g} deg", angle.get<double>())
-                                                               : std::string("all conditions")] =
-          pick(c, "critical_velocity_m_s");
-    }
-    h["breakage"]["critical_largest_fraction"] = crit.empty() ? nlohmann::json(nullptr) : pick(crit[0], "threshold");
-  }
-  const auto prod = read_json(run / "breakage" / "product.json", problems);
-  if (prod.is_array())
-    for (const auto& p : prod)
-      if (pick(p, "rpm").is_number()) h["product"][fmt::format("rpm{:g}", pick(p, "rpm").get<double>())] = {
-          {"fully_shredded_mass_fraction", pick(p, "fully_shredded_mass_fraction")},
-          {"largest_piece_mass_fraction", pick(p, "largest_piece_mass_fraction")},
-          {"t10_percent", pick(p, "t10_percent")},
-          {"conditions", pick(p, "conditions")}};
-  return h;
+  o << "</table><p class=note>Sizes are d/D x the lump diameter ("
+    << fmt::format("{:g}", report::pick(sd, "lump_diameter_mm").is_number() ? sd["lump_diameter_mm"].get<double>() : 0.0)
+    << " mm); P50 and P80 are interpolated log-linearly between sieves.</p>\n";
 }
 
 }  // namespace
@@ -203,7 +123,7 @@ Plan ReportStage::plan(const StageContext& ctx) const {
     in.push_back({fs::relative(f, ctx.run_dir).string(), static_cast<long long>(st.st_size),
                   static_cast<long long>(st.st_mtime)});
   }
-  p.jobs.push_back({"report", {{"inputs", in}, {"report_version", 2}},
+  p.jobs.push_back({"report", {{"inputs", in}, {"report_version", 3}},
                     "report/index.html and report/summary.json from every stage's outputs"});
   return p;
 }
@@ -218,8 +138,9 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
   const fs::path run = ctx.run_dir, out_dir = ctx.stage_dir;
   const auto inputs = report_inputs(run);
   Problems problems;
-  nlohmann::json summary = {{"case", ctx.cfg.name}, {"ore", ctx.cfg.ore.str("name")},
-                            {"headline", headline(run, problems)}};
+  nlohmann::json summary = {
+      {"case", ctx.cfg.name}, {"ore", ctx.cfg.ore.str("name")}, {"headline", report::headline_json(run, &problems)}};
+  const auto rows = report::headline_rows(summary["headline"]);
 
   // Figures drawn for the report from the flow stage's files: the mill
   // geometry and the solver's convergence (matplotlib, Debian's python3).
@@ -237,12 +158,7 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
     ctx.runner.run(c);
   }
   std::ostringstream o;
-  o << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>Beater mill: " << esc(ctx.cfg.name)
-    << "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
-       "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}"
-       "td:first-child{text-align:left}img{max-width:100%;border:1px solid #eee;margin:0.5em 0}"
-       "h2{border-bottom:2px solid #468;padding-bottom:2px}.note{color:#666}"
-       ".bad{color:#a00;border:1px solid #a00;padding:0.5em}</style></head><body>\n";
+  o << report::page_head("Beater mill: " + ctx.cfg.name);
   o << "<h1>Beater mill: case " << esc(ctx.cfg.name) << "</h1>\n";
   if (ctx.cfg.doc.has("description")) o << "<p>" << esc(ctx.cfg.doc.str("description")) << "</p>\n";
   o << "<p class=note>Case file <code>" << esc(ctx.cfg.file.string()) << "</code>, ore card <code>"
@@ -268,14 +184,28 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
     summary["unconverged_flow"] = unconverged;
   }
 
-  o << "<h2>Headline numbers</h2>\n";
-  if (summary["headline"].empty()) o << "<p class=note>No stage has produced results yet.</p>\n";
-  else json_table(o, summary["headline"]);
+  // The headline: a short table in words and units, grouped by stage.
+  o << "<h2>Headline</h2>\n";
+  if (rows.empty()) {
+    o << "<p class=note>No stage has produced results yet.</p>\n";
+  } else {
+    o << "<table class=headline>\n";
+    std::string group;
+    for (const auto& r : rows) {
+      if (!r.brief) continue;  // shown in its stage's section
+      if (r.group != group) o << "<tr class=group><th colspan=2>" << esc(r.group) << "</th></tr>\n";
+      group = r.group;
+      o << "<tr><td>" << esc(r.what) << "</td><td>" << esc(r.value) << "</td></tr>\n";
+    }
+    o << "</table>\n";
+  }
 
   o << "<h2>Case and ore card</h2>\n";
   if (fs::exists(figures / "mill_geometry.png")) embed_png(o, figures / "mill_geometry.png", "mill geometry (STL)");
+  ore_table(o, ctx.cfg.ore);
+  o << fold("The ore card as written") ;
   json_table(o, ctx.cfg.ore.to_json());
-  o << "<details><summary>All case keys (defaults included)</summary>\n";
+  o << "</details>\n" << fold("All case keys (defaults included)");
   json_table(o, ctx.cfg.doc.to_json());
   o << "</details>\n";
 
@@ -290,6 +220,7 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
     for (const auto& f : inputs)
       if (fs::relative(f, run).begin()->string() == stage) mine.push_back(f);
     o << "<h2>" << esc(title) << "</h2>\n";
+    // Figures first, then the stage's labelled numbers, then the raw data folded.
     if (stage == "flow" && fs::is_directory(figures))
       for (const auto& f : fs::directory_iterator(figures))
         if (f.path().filename().string().rfind("flow_convergence_", 0) == 0)
@@ -299,51 +230,64 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
         << "</code>).</p>\n";
       continue;
     }
+    std::vector<fs::path> pngs;
+    for (const auto& f : mine)
+      if (f.extension() == ".png") pngs.push_back(f);
+    std::stable_sort(pngs.begin(), pngs.end(),
+                     [](const fs::path& a, const fs::path& b) { return figure_rank(a) < figure_rank(b); });
+    for (const auto& f : pngs) embed_png(o, f, fs::relative(f, run).string());
+    stage_numbers(o, rows, stage);
+    if (stage == "breakage")
+      size_table(o, report::read_json(run / "breakage" / "size_distributions.json", &problems));
+
+    std::ostringstream raw;
+    std::string links;
     for (const auto& f : mine) {
       const std::string rel = fs::relative(f, out_dir).string();
       const std::string name = fs::relative(f, run).string();
       if (f.extension() == ".json") {
-        const nlohmann::json j = read_json(f, problems);
+        const nlohmann::json j = report::read_json(f, &problems);
         if (j.is_null()) {
-          o << "<h3>" << esc(name) << "</h3>\n<p class=bad>Not shown: this file is damaged (see the top of the "
+          o << "<p class=bad><code>" << esc(name) << "</code> not shown: this file is damaged (see the top of the "
             << "page).</p>\n";
           continue;
         }
-        o << "<h3>" << esc(name) << "</h3>\n";
-        if (j.is_object()) json_table(o, j);
+        raw << "<h3>" << esc(name) << "</h3>\n";
+        if (j.is_object()) json_table(raw, j);
         else if (j.is_array())
           for (const auto& e : j)
-            if (e.is_object()) json_table(o, e);
+            if (e.is_object()) json_table(raw, e);
         summary[name] = j;
-      } else if (f.extension() == ".png") {
-        embed_png(o, f, name);
+        links += (links.empty() ? "" : ", ") + std::string("<a href=\"") + esc(rel) + "\">" + esc(name) + "</a>";
       } else if (f.extension() == ".csv" || f.extension() == ".md") {
-        o << "<p>Data: <a href=\"" << esc(rel) << "\">" << esc(name) << "</a></p>\n";
+        links += (links.empty() ? "" : ", ") + std::string("<a href=\"") + esc(rel) + "\">" + esc(name) + "</a>";
       }
     }
-    std::vector<post::ImpactSummary> rows;
+    if (!links.empty()) o << "<p class=note>Data: " << links << "</p>\n";
+    std::vector<post::ImpactSummary> impacts;
     if (stage == "breakage" && fs::exists(run / "breakage" / "summary.csv")) {
       try {
-        rows = post::ReadSummaryCsv((run / "breakage" / "summary.csv").string());
+        impacts = post::ReadSummaryCsv((run / "breakage" / "summary.csv").string());
       } catch (const std::exception& e) {
         problems.push_back({run / "breakage" / "summary.csv", e.what()});
       }
     }
-    if (!rows.empty()) {
-      o << "<table><tr><th>V [m/s]</th><th>angle [deg]</th><th>repeat</th><th>pieces</th><th>single</th>"
-           "<th>multi</th><th>largest [%]</th><th>single mass [%]</th><th>broken bonds [%]</th><th>E [kWh/t]</th>"
-           "<th>t10 [%]</th></tr>\n";
-      for (const auto& r : rows)
-        o << fmt::format(
+    if (!impacts.empty()) {
+      raw << "<h3>Every impact</h3><table><tr><th>V [m/s]</th><th>angle [deg]</th><th>repeat</th><th>pieces</th>"
+             "<th>single</th><th>multi</th><th>largest [%]</th><th>single mass [%]</th><th>broken bonds [%]</th>"
+             "<th>Ecs [kWh/t]</th><th>t10 [%]</th></tr>\n";
+      for (const auto& r : impacts)
+        raw << fmt::format(
             "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>"
             "<td>{}</td><td>{}</td><td>{}{}</td></tr>\n",
             cell(r.velocity_m_s, "{:g}"), cell(r.angle_deg, "{:g}"), r.repeat, r.n_pieces, r.n_single, r.n_multi,
             cell(r.largest_mass_fraction, "{:.1f}", 100), cell(r.single_mass_fraction, "{:.1f}", 100),
             cell(r.broken_bond_fraction, "{:.1f}", 100), cell(r.specific_energy_kWh_t, "{:.3g}"),
             cell(r.t10_percent, "{:.1f}"), r.t10_resolved ? "" : "*");
-      o << "</table><p class=note>* t10 not resolved: single elements are coarser than a tenth of the lump.</p>\n";
-      summary["breakage_impacts"] = rows.size();
+      raw << "</table><p class=note>* t10 not resolved: single elements are coarser than a tenth of the lump.</p>\n";
+      summary["breakage_impacts"] = impacts.size();
     }
+    if (!raw.str().empty()) o << fold("Raw results: every key of the stage's JSON files") << raw.str() << "</details>\n";
   }
   if (!problems.empty()) {
     // Named at the top of the page, in summary.json and on the console.
@@ -362,12 +306,11 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
            "report.</div>\n";
     summary["damaged_inputs"] = list;
     std::string page = o.str();
-    const std::string anchor = "<h2>Headline numbers</h2>";
-    page.insert(page.find(anchor), box.str());
+    page.insert(page.find("<h2>Headline</h2>"), box.str());
     o.str(page);
     o.seekp(0, std::ios::end);
   }
-  o << "<hr><p class=note>Generated by orchestrate " << MILL_VERSION << ".</p></body></html>\n";
+  o << report::page_tail();
   jobs::atomic_write(out_dir / "index.html", o.str());
   jobs::atomic_write(out_dir / "summary.json", summary.dump(2) + "\n");
   ctx.progress.info("[report] " + (out_dir / "index.html").string());

@@ -86,6 +86,17 @@ inline bool wait_for(const std::function<bool()>& ready, double seconds) {
   return ready();
 }
 
+// Leaves the finished run folder `run` for later tests (CTest fixtures): when
+// $MILL_E2E_KEEP_RUN is set, a symlink of that name points at `run`.
+inline void keep_run(const fs::path& run) {
+  const char* keep = std::getenv("MILL_E2E_KEEP_RUN");
+  if (!keep || !*keep) return;
+  const fs::path link(keep);
+  fs::create_directories(link.parent_path());
+  fs::remove_all(link);
+  fs::create_directory_symlink(fs::absolute(run), link);
+}
+
 // State of job `label` of the stage whose folder is `stage_dir`.
 inline jobs::State job_state(const fs::path& stage_dir, const std::string& label) {
   return jobs::JobStore(stage_dir).read_status(label).state;

@@ -6,6 +6,9 @@
 // job that had finished (checked by the jobs' STATUS modification times).
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
+#include <cctype>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -117,6 +120,34 @@ TEST(WholeWorkflow, StageAllKilledMidBreakageResumesWithoutRedoingJobs) {
   const double shredded = prod.at("fully_shredded_mass_fraction").get<double>();
   EXPECT_GE(shredded, 0.0);
   EXPECT_LE(shredded, 1.0);
+
+  // The mill product in mm: P80 in product.json, drawn against rpm, in the headline in words.
+  const auto product = nlohmann::json::parse(slurp(run / "breakage/product.json"));
+  ASSERT_EQ(product.size(), 1u);
+  const auto& p0 = product[0];
+  ASSERT_TRUE(p0.at("p80_mm").is_number()) << p0.dump();
+  const double p80 = p0.at("p80_mm").get<double>();
+  EXPECT_GT(p80, 0.0);
+  EXPECT_LE(p80, 20.0);  // no piece is coarser than the 20 mm lump
+  EXPECT_DOUBLE_EQ(prod.at("p80_mm").get<double>(), p80);
+  const size_t head = html.find("<h2>Headline</h2>"), head_end = html.find("<h2>", head + 1);
+  ASSERT_NE(head, std::string::npos);
+  const std::string headline = html.substr(head, head_end - head);
+  EXPECT_NE(headline.find(fmt::format("{:.3g} mm", p80)), std::string::npos) << headline;
+  EXPECT_NE(headline.find("gas mass flow through the mill, 2000 rpm"), std::string::npos) << headline;
+  EXPECT_NE(headline.find("calibrated UCS"), std::string::npos) << headline;
+  // No dotted keys (calibration.achieved.ucs) in the headline: only words and numbers.
+  for (size_t i = 1; i + 1 < headline.size(); ++i)
+    if (headline[i] == '.' && std::isalpha(static_cast<unsigned char>(headline[i - 1])) &&
+        std::isalpha(static_cast<unsigned char>(headline[i + 1])))
+      ADD_FAILURE() << "dotted key in the headline: " << headline.substr(i > 30 ? i - 30 : 0, 60);
+  // The raw per-rpm keys of the flow report are folded away.
+  const size_t raw = html.find("flow/flow_summary.json</h3>");
+  ASSERT_NE(raw, std::string::npos);
+  const size_t open = html.rfind("<details>", raw), close = html.rfind("</details>", raw);
+  ASSERT_NE(open, std::string::npos);
+  EXPECT_TRUE(close == std::string::npos || close < open) << "flow_summary.json is not inside a <details> block";
+  keep_run(run);  // a finished run for e2e.compare and report.browser
 }
 
 }  // namespace

@@ -35,9 +35,33 @@ int TinyCampaign::status_ = -1;
 TEST_F(TinyCampaign, RunsAndWritesEveryOutput) {
   ASSERT_EQ(status_, 0) << slurp(*dir_ / "first.log");
   for (const char* f : {"summary.csv", "fractions.csv", "breakage.h5", "critical_velocity.json",
-                        "plots/largest_vs_velocity.png", "plots/pieces_vs_velocity.png", "plots/mass_distribution.png",
-                        "jobs/v20_a90_r0/fragments.vtp", "jobs/v20_a90_r0/result.json"})
+                        "size_distributions.csv", "size_distributions.json", "jk_fit.json", "jk_points.csv",
+                        "plots/largest_vs_velocity.png", "plots/pieces_vs_velocity.png", "plots/passing_vs_size.png",
+                        "plots/jk_t10_vs_ecs.png", "jobs/v20_a90_r0/fragments.vtp", "jobs/v20_a90_r0/result.json"})
     EXPECT_TRUE(fs::exists(*dir_ / "breakage" / f)) << f;
+  EXPECT_FALSE(fs::exists(*dir_ / "breakage/plots/mass_distribution.png"));  // replaced by the passing curves
+}
+
+// Passing curves in mm: the intact lump at 1 m/s is all in the top size
+// fraction, so its P80 lies in the top sieve interval (0.85-1 x the 20 mm
+// lump); shattered at 150 m/s it is far finer.
+TEST_F(TinyCampaign, SizeDistributionsInMillimetres) {
+  ASSERT_EQ(status_, 0);
+  const auto sd = nlohmann::json::parse(slurp(*dir_ / "breakage/size_distributions.json"));
+  EXPECT_DOUBLE_EQ(sd.at("lump_diameter_mm").get<double>(), 20.0);
+  const auto& conds = sd.at("conditions");
+  ASSERT_EQ(conds.size(), 3u);
+  const double slow = conds[0].at("p80_mm").get<double>();
+  EXPECT_GT(slow, 17.0);
+  EXPECT_LE(slow, 20.0);
+  EXPECT_LT(conds[2].at("p80_mm").get<double>(), 0.5 * slow);
+  EXPECT_NEAR(conds[0].at("passing_percent").back().get<double>(), 100.0, 1e-9);
+  // A 200-element lump cannot resolve t10: no JK fit, and the reason says so.
+  const auto jk = nlohmann::json::parse(slurp(*dir_ / "breakage/jk_fit.json"));
+  ASSERT_EQ(jk.size(), 1u);
+  EXPECT_FALSE(jk[0].at("fitted").get<bool>());
+  EXPECT_EQ(jk[0].at("points_used").get<int>(), 0);
+  EXPECT_NE(jk[0].at("reason").get<std::string>().find("not resolved"), std::string::npos);
 }
 
 TEST_F(TinyCampaign, SlowImpactBouncesIntactFastOneShatters) {
@@ -140,6 +164,10 @@ TEST_F(TinyCampaign, ReportEmbedsTheBreakageResults) {
   EXPECT_NE(html.find("has not run"), std::string::npos);  // flow etc. did not run here
   const auto summary = nlohmann::json::parse(slurp(*dir_ / "report/summary.json"));
   EXPECT_EQ(summary.at("breakage_impacts").get<int>(), 3);
+  // The headline says it in words: the critical speed at 90 degrees.
+  EXPECT_NE(html.find("critical impact speed (largest piece &lt; 5%), 90 deg"), std::string::npos);
+  EXPECT_NE(html.find("breakage/plots/passing_vs_size.png"), std::string::npos);
+  keep_run(*dir_);  // a finished run for e2e.compare
 }
 
 }  // namespace

@@ -66,7 +66,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_ore_moment_factor.yaml", {"bad_ore_moment_factor_card.yaml:8:", "calibrated.bond_moment_factor", "1.5", "[0, 1]"}},
         BadCase{"bad_resources_time.yaml", {":3:", "resources.breakage.time", "'2 hours'", "Slurm wall time"}},
         BadCase{"bad_resources_partition.yaml", {":4:", "resources.flow.partition", "'big\\x0anodes'", "partition name"}},
-        BadCase{"bad_resources_np.yaml", {":3:", "resources.breakage.np", "integer >= 1", "got 0"}}),
+        BadCase{"bad_resources_np.yaml", {":3:", "resources.breakage.np", "integer >= 1", "got 0"}},
+        BadCase{"bad_ore_jk_A.yaml", {"bad_ore_jk_A_card.yaml:8:", "jk.A", "120", "(0, 100] %"}},
+        BadCase{"bad_ore_jk_pair.yaml", {"bad_ore_jk_pair_card.yaml:8:", "jk.b", "without jk.A"}}),
     [](const auto& info) {
       std::string n = info.param.file;
       n = n.substr(0, n.find('.'));

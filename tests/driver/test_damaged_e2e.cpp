@@ -50,6 +50,13 @@ class DamagedRun : public ::testing::Test {
     for (size_t i = 0; i < r.size(); ++i) out += (i ? "," : "") + r[i];
     spit(f, out + "\n");
   }
+  // The page's text: every embedded picture's base64 data left out.
+  static std::string without_images(std::string html) {
+    const std::string key = "data:image/png;base64,";
+    for (size_t at = html.find(key); at != std::string::npos; at = html.find(key, at + key.size()))
+      html.erase(at + key.size(), html.find('"', at + key.size()) - at - key.size());
+    return html;
+  }
   static fs::path* dir_;
   static int status_;
 };
@@ -121,7 +128,7 @@ TEST_F(DamagedRun, ReportNamesDamagedInputsAndPrintsNanAsNa) {
   ASSERT_EQ(run("report", "nan_real.log"), 0) << log("nan_real.log");
   std::string html = slurp(*dir_ / "report/index.html");
   EXPECT_NE(html.find("<td>n/a</td>"), std::string::npos);
-  EXPECT_EQ(html.find("nan"), std::string::npos);
+  EXPECT_EQ(without_images(html).find("nan"), std::string::npos);  // base64 of a figure may hold "nan"
 
   set_csv_cell(*dir_ / "breakage/summary.csv", "n_pieces", "nan");
   fs::create_directories(*dir_ / "flow");

@@ -272,5 +272,49 @@ TEST(BreakageH5, MergeOfPerImpactFiles) {
   EXPECT_FALSE(fs::exists(dir / "twice.h5"));
 }
 
+// The JK fit goes into an existing breakage.h5 under /jk_fit/<name>, with
+// units; written twice, the group is replaced, not duplicated.
+TEST(BreakageH5, JkFitGroupWithUnits) {
+  const auto dir = TestDir();
+  const std::string path = (dir / "breakage.h5").string();
+  WriteBreakageH5(path, {MakeImpact(150.0, 0)});
+  JkFitRecord rec;
+  rec.name = "a90";
+  std::vector<JkPoint> pts;
+  for (double v : {20.0, 50.0, 90.0, 150.0}) {
+    const double e = SpecificEnergyKWhPerTonne(v);
+    rec.ecs_kwh_t.push_back(e);
+    rec.t10_percent.push_back(JkT10(45.0, 2.0, e));
+    rec.repeat.push_back(0);
+    rec.used.push_back(1);
+    pts.push_back({e, rec.t10_percent.back(), 0});
+  }
+  rec.fit = FitJkSweep(pts);
+  ASSERT_TRUE(rec.fit.pooled.ok);
+  WriteJkFitH5(path, {rec});
+  WriteJkFitH5(path, {rec});
+
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  EXPECT_GT(H5Lexists(file, "/impacts/v150.0_a90_r0", H5P_DEFAULT), 0);  // the impacts stay
+  const hid_t a = H5Dopen2(file, "/jk_fit/a90/A", H5P_DEFAULT);
+  ASSERT_GE(a, 0);
+  double value = 0;
+  H5Dread(a, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, &value);
+  EXPECT_NEAR(value, 45.0, 1e-6);
+  EXPECT_EQ(ReadStringAttr(a, "unit"), "%");
+  H5Dclose(a);
+  const hid_t b = H5Dopen2(file, "/jk_fit/a90/b", H5P_DEFAULT);
+  EXPECT_EQ(ReadStringAttr(b, "unit"), "t/kWh");
+  H5Dclose(b);
+  const hid_t e = H5Dopen2(file, "/jk_fit/a90/ecs", H5P_DEFAULT);
+  EXPECT_EQ(ReadStringAttr(e, "unit"), "kWh/t");
+  H5Dclose(e);
+  const hid_t g = H5Gopen2(file, "/jk_fit/a90", H5P_DEFAULT);
+  EXPECT_EQ(ReadStringAttr(g, "status"), "fitted");
+  H5Gclose(g);
+  H5Fclose(file);
+}
+
 }  // namespace
 }  // namespace mill::post

@@ -93,3 +93,45 @@ TEST(CriticalVelocity, SpreadOverRepeats) {
 
 }  // namespace
 }  // namespace mill::post
+
+namespace mill::post {
+namespace {
+
+TEST(PassingCurve, CumulativePercentIsTheRunningSum) {
+  const auto p = CumulativePassingPercent({0.1, 0.3, 0.6});
+  ASSERT_EQ(p.size(), 3u);
+  EXPECT_DOUBLE_EQ(p[0], 10.0);
+  EXPECT_DOUBLE_EQ(p[1], 40.0);
+  EXPECT_DOUBLE_EQ(p[2], 100.0);
+}
+
+TEST(PassingCurve, P80ByHandBetweenTwoSieves) {
+  // 70 % passes 4 mm, 100 % 8 mm: P80 = 4 x 2^(10/30) mm.
+  const std::vector<double> sieves = {1, 2, 4, 8}, passing = {10, 40, 70, 100};
+  EXPECT_NEAR(*SizeAtPercentPassing(sieves, passing, 80), 4 * std::pow(2.0, 1.0 / 3.0), 1e-12);
+  EXPECT_NEAR(*SizeAtPercentPassing(sieves, passing, 40), 2.0, 1e-12);  // on a sieve
+  EXPECT_FALSE(SizeAtPercentPassing(sieves, passing, 5));               // finer than 1 mm
+  EXPECT_FALSE(SizeAtPercentPassing({1, 2}, {10, 60}, 80));             // never reached
+  EXPECT_THROW(SizeAtPercentPassing({2, 1}, {10, 60}, 50), PostError);
+}
+
+// A distribution whose passing is exactly linear in log(size) between 0.5
+// and 40 mm: P(d) = 100 ln(d / 0.5) / ln(80); P80 = 0.5 x 80^0.8 mm, whatever
+// sieves it is read at.
+TEST(PassingCurve, P50AndP80OfALogUniformDistribution) {
+  const std::vector<double> sieves = {1.0, 2.5, 6.0, 13.0, 27.0, 40.0};
+  std::vector<double> mass;
+  double below = 0.0;
+  for (double s : sieves) {
+    const double p = std::log(s / 0.5) / std::log(80.0);
+    mass.push_back(p - below);
+    below = p;
+  }
+  const auto passing = CumulativePassingPercent(mass);
+  EXPECT_NEAR(passing.back(), 100.0, 1e-12);
+  EXPECT_NEAR(*SizeAtPercentPassing(sieves, passing, 80), 0.5 * std::pow(80.0, 0.8), 1e-9);
+  EXPECT_NEAR(*SizeAtPercentPassing(sieves, passing, 50), 0.5 * std::pow(80.0, 0.5), 1e-9);
+}
+
+}  // namespace
+}  // namespace mill::post

@@ -9,6 +9,7 @@
 
 #include "postprocess/breakage_results.h"
 #include "postprocess/distributions.h"
+#include "postprocess/jk_fit.h"
 
 namespace mill::post {
 namespace {
@@ -29,7 +30,10 @@ TEST(PlotBreakage, WritesPngsAndCriticalVelocity) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string summary = (dir / "summary.csv").string();
-  const std::string fractions = (dir / "fractions.csv").string();
+  const std::string passing = (dir / "size_distributions.csv").string();
+  std::ofstream pass(passing);
+  pass << "velocity_m_s,angle_deg,sieve_mm,passing_percent,passing_percent_min,passing_percent_"
+          "max\n";
 
   // Two repeats at four speeds; largest piece falls from 1 to 0.01.
   const double speeds[] = {20.0, 60.0, 100.0, 150.0};
@@ -49,21 +53,20 @@ TEST(PlotBreakage, WritesPngsAndCriticalVelocity) {
       s.largest_mass_fraction = largest[rep][k];
       s.specific_energy_J_kg = 0.5 * speeds[k] * speeds[k];
       AppendSummaryCsv(summary, s);
-      r.fraction_edges = DefaultFractionEdges();
-      r.fraction_mass.assign(12, 0.0);
-      r.fraction_mass[11 - 3 * k] = largest[rep][k];
-      r.fraction_mass[0] = 1.0 - largest[rep][k];
-      AppendFractionsCsv(fractions, r);
       points.push_back({speeds[k], rep, largest[rep][k]});
     }
+    for (double sieve : {2.0, 4.0, 8.0, 16.0, 40.0})
+      pass << speeds[rep] << ",90," << sieve << "," << 100 * sieve / 40 << "," << 90 * sieve / 40
+           << "," << 100 * sieve / 40 << "\n";
   }
+  pass.close();
   const fs::path out = dir / "plots";
-  const std::string cmd = kPython + " " + kScript + " --summary " + summary + " --fractions " +
-                          fractions + " --out " + out.string() +
+  const std::string cmd = kPython + " " + kScript + " --summary " + summary + " --passing " +
+                          passing + " --out " + out.string() +
                           " --threshold 0.05 --velocities 20,100,150";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   for (const char* png :
-       {"pieces_vs_velocity.png", "largest_vs_velocity.png", "mass_distribution.png"}) {
+       {"pieces_vs_velocity.png", "largest_vs_velocity.png", "passing_vs_size.png"}) {
     ASSERT_TRUE(fs::exists(out / png)) << png;
     EXPECT_GT(fs::file_size(out / png), 1000u) << png;
   }
@@ -77,16 +80,42 @@ TEST(PlotBreakage, WritesPngsAndCriticalVelocity) {
   EXPECT_NEAR(a.at("std_m_s").get<double>(), *c.stddev, 1e-9);
 }
 
+TEST(PlotJk, DrawsPointsFitAndOreCardAndNamesABadFile) {
+  if (!PythonHasPlotting()) GTEST_SKIP() << kPython << " lacks matplotlib/numpy";
+  const fs::path dir = fs::temp_directory_path() / "mill_post_plot_jk";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream pts(dir / "jk_points.csv");
+  pts << "angle_deg,velocity_m_s,repeat,ecs_kWh_t,t10_percent,t10_resolved\n";
+  for (double v : {20.0, 60.0, 100.0, 150.0}) {
+    const double e = SpecificEnergyKWhPerTonne(v);
+    pts << "90," << v << ",0," << e << "," << JkT10(50, 1.1, e) << "," << (v > 20 ? 1 : 0) << "\n";
+  }
+  pts.close();
+  std::ofstream(dir / "jk_fit.json")
+      << R"([{"angle_deg": 90, "fitted": true, "A_percent": 50, "b_t_per_kWh": 1.1,)"
+      << R"( "ore_card": {"A_percent": 55, "b_t_per_kWh": 0.9}}])";
+  const std::string base = kPython + " " + MILL_PLOT_JK_SCRIPT + " --points " +
+                           (dir / "jk_points.csv").string() + " --out " + (dir / "plots").string() +
+                           " --fit ";
+  ASSERT_EQ(std::system((base + (dir / "jk_fit.json").string()).c_str()), 0);
+  EXPECT_GT(fs::file_size(dir / "plots" / "jk_t10_vs_ecs.png"), 1000u);
+  std::ofstream(dir / "bad.json") << R"([{"angle_deg": 90, "fitted": true}])";
+  const std::string bad = base + (dir / "bad.json").string() + " 2> " + (dir / "err.txt").string();
+  EXPECT_NE(std::system(bad.c_str()), 0);
+  std::ifstream err(dir / "err.txt");
+  const std::string text((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("A_percent"), std::string::npos) << text;
+}
+
 TEST(PlotBreakage, MissingColumnFailsWithItsName) {
   if (!PythonHasPlotting()) GTEST_SKIP() << kPython << " lacks matplotlib/numpy";
   const fs::path dir = fs::temp_directory_path() / "mill_post_plot_bad";
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ofstream(dir / "s.csv") << "velocity_m_s,angle_deg\n1,90\n";
-  std::ofstream(dir / "f.csv") << "velocity_m_s\n1\n";
   const std::string cmd = kPython + " " + kScript + " --summary " + (dir / "s.csv").string() +
-                          " --fractions " + (dir / "f.csv").string() + " --out " +
-                          (dir / "o").string() + " 2> " + (dir / "err.txt").string();
+                          " --out " + (dir / "o").string() + " 2> " + (dir / "err.txt").string();
   EXPECT_NE(std::system(cmd.c_str()), 0);
   std::ifstream err(dir / "err.txt");
   const std::string text((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());

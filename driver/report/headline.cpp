@@ -1,0 +1,311 @@
+// The headline numbers and their words; see headline.h.
+#include "report/headline.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "report/html.h"
+
+namespace mill::report {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+// Rotor-speed folders of a stage ("rpm1500", "rpm2000"), slowest first.
+std::vector<std::string> rpm_dirs(const fs::path& stage) {
+  std::vector<std::pair<double, std::string>> found;
+  if (!fs::is_directory(stage)) return {};
+  for (const auto& e : fs::directory_iterator(stage)) {
+    const std::string name = e.path().filename().string();
+    if (!e.is_directory() || name.rfind("rpm", 0) != 0) continue;
+    try {
+      found.push_back({std::stod(name.substr(3)), name});
+    } catch (const std::exception&) {
+    }
+  }
+  std::sort(found.begin(), found.end());
+  std::vector<std::string> out;
+  for (const auto& f : found) out.push_back(f.second);
+  return out;
+}
+
+// The keys of a per-rpm object, slowest first ("rpm500" before "rpm1500").
+std::vector<std::string> rpm_keys(const json& j) {
+  std::vector<std::pair<double, std::string>> found;
+  if (!j.is_object()) return {};
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    try {
+      found.push_back({std::stod(it.key().substr(3)), it.key()});
+    } catch (const std::exception&) {
+      found.push_back({0.0, it.key()});
+    }
+  }
+  std::sort(found.begin(), found.end());
+  std::vector<std::string> out;
+  for (const auto& f : found) out.push_back(f.second);
+  return out;
+}
+
+bool num(const json& v) { return v.is_number(); }
+double d(const json& v) { return v.get<double>(); }
+
+// A number with about three significant figures, no exponent for everyday sizes.
+std::string g3(double x) { return std::abs(x) >= 100 ? fmt::format("{:.0f}", x) : fmt::format("{:.3g}", x); }
+
+// A speed in whole m/s (two figures below 10 m/s).
+std::string speed(double v) { return std::abs(v) >= 10 ? fmt::format("{:.0f}", v) : fmt::format("{:.2g}", v); }
+
+// "2000 rpm" from "rpm2000".
+std::string rpm_words(const std::string& key) { return key.substr(3) + " rpm"; }
+
+std::string percent(double fraction) { return fmt::format("{:.0f}%", 100 * fraction); }
+
+}  // namespace
+
+const std::vector<HeadlineGroup>& headline_groups() {
+  static const std::vector<HeadlineGroup> g = {{"flow", "Gas flow (stage 1a)"},
+                                               {"transport", "Ore lumps through the mill (stage 1b)"},
+                                               {"calibrate", "Calibration of the bond model"},
+                                               {"breakage", "Breakage of one lump (stage 2)"},
+                                               {"breakage", "Mill product, one pass (stages 1 and 2)"}};
+  return g;
+}
+
+json headline_json(const fs::path& run, Problems* problems) {
+  json h = json::object();
+  for (const auto& rpm : rpm_dirs(run / "flow")) {
+    const auto f = read_json(run / "flow" / rpm / "flow_report.json", problems);
+    if (f.is_null()) continue;
+    json e = {{"domain", pick(f, "domain")},
+              {"cells", pick(f, "cells")},
+              {"iterations", pick(f, "iterations")},
+              {"converged", pick(f, "converged")},
+              {"residual_target", pick(f, "residual_target")},
+              {"mass_imbalance_relative", pick(pick(f, "mass_flow_kg_s"), "imbalance_relative")},
+              {"inlet_mass_flow_kg_s", pick(pick(f, "mass_flow_kg_s"), "inlet_in")},
+              {"rim_gas_speed_to_tip_speed", pick(pick(f, "rim"), "ratio_speed_to_tip_speed")}};
+    // The flywheel's shaft torque and power (flow_report.json "shaft"), and
+    // the backflow through the openings ("backflow_kg_s").
+    const json shaft = pick(f, "shaft");
+    if (num(pick(shaft, "power_W"))) e["shaft_power_W"] = pick(shaft, "power_W");
+    if (num(pick(shaft, "torque_Nm"))) e["shaft_torque_Nm"] = pick(shaft, "torque_Nm");
+    const json back = pick(f, "backflow_kg_s");
+    if (num(pick(back, "outlet_in"))) e["backflow_outlet_in_kg_s"] = pick(back, "outlet_in");
+    if (num(pick(back, "inlet_out"))) e["backflow_inlet_out_kg_s"] = pick(back, "inlet_out");
+    h["flow"][rpm] = e;
+  }
+  for (const auto& rpm : rpm_dirs(run / "transport")) {
+    const auto t = read_json(run / "transport" / rpm / "summary.json", problems);
+    if (t.is_null()) continue;
+    h["transport"][rpm] = {{"lumps", pick(t, "n_particles")},
+                           {"flywheel_impacts", pick(t, "n_flywheel_impacts")},
+                           {"wall_impacts", pick(t, "n_wall_impacts")},
+                           {"flywheel_impact_speed_mean_m_s", pick(t, "flywheel_impact_speed_mean_m_s")},
+                           {"flywheel_impact_speed_std_m_s", pick(t, "flywheel_impact_speed_std_m_s")},
+                           {"flywheel_normal_speed_mean_m_s", pick(t, "flywheel_normal_speed_mean_m_s")},
+                           {"flywheel_angle_mean_deg", pick(t, "flywheel_angle_mean_deg")}};
+  }
+  const auto cal = read_json(run / "calibrate" / "report.json", problems);
+  if (!cal.is_null())
+    h["calibration"] = {{"source", pick(cal, "source")},
+                        {"converged", pick(cal, "converged")},
+                        {"targets", pick(cal, "targets")},
+                        {"achieved", pick(cal, "achieved")},
+                        {"within_tolerance", pick(cal, "within_tolerance")}};
+  const auto crit = read_json(run / "breakage" / "critical_velocity.json", problems);
+  if (crit.is_array()) {
+    json c = json::array();
+    for (const auto& e : crit)
+      c.push_back({{"angle_deg", pick(e, "angle_deg")},
+                   {"critical_velocity_m_s", pick(e, "critical_velocity_m_s")},
+                   {"min_m_s", pick(e, "min_m_s")},
+                   {"max_m_s", pick(e, "max_m_s")},
+                   {"largest_fraction_threshold", pick(e, "threshold")}});
+    h["breakage"]["critical_speed"] = c;
+  }
+  const auto jk = read_json(run / "breakage" / "jk_fit.json", problems);
+  if (jk.is_array()) {
+    json c = json::array();
+    for (const auto& e : jk) {
+      json x = {{"angle_deg", pick(e, "angle_deg")}, {"fitted", pick(e, "fitted")}, {"ore_card", pick(e, "ore_card")}};
+      for (const char* k : {"A_percent", "b_t_per_kWh", "A_times_b", "over_repeats", "repeats_fitted", "reason",
+                            "points_used", "points"})
+        if (e.contains(k)) x[k] = e.at(k);
+      c.push_back(x);
+    }
+    h["breakage"]["jk"] = c;
+  }
+  const auto prod = read_json(run / "breakage" / "product.json", problems);
+  if (prod.is_array())
+    for (const auto& p : prod)
+      if (num(pick(p, "rpm")))
+        h["product"][fmt::format("rpm{:g}", d(pick(p, "rpm")))] = {
+            {"fully_shredded_mass_fraction", pick(p, "fully_shredded_mass_fraction")},
+            {"largest_piece_mass_fraction", pick(p, "largest_piece_mass_fraction")},
+            {"t10_percent", pick(p, "t10_percent")},
+            {"conditions", pick(p, "conditions")},
+            {"p50_mm", pick(p, "p50_mm")},
+            {"p80_mm", pick(p, "p80_mm")},
+            {"finest_sieve_mm", pick(p, "sieves_mm").is_array() && !pick(p, "sieves_mm").empty()
+                                    ? pick(p, "sieves_mm")[0]
+                                    : json(nullptr)}};
+  return h;
+}
+
+std::vector<HeadlineRow> headline_rows(const json& h) {
+  std::vector<HeadlineRow> rows;
+  const auto& groups = headline_groups();
+  auto add = [&](size_t group, std::string what, std::string value, bool brief = true) {
+    rows.push_back({groups[group].title, std::move(what), std::move(value), brief});
+  };
+
+  const json flow = pick(h, "flow");
+  for (const auto& rpm : rpm_keys(flow)) {
+    const json& f = flow.at(rpm);
+    const std::string at = ", " + rpm_words(rpm);
+    if (num(pick(f, "inlet_mass_flow_kg_s")))
+      add(0, "gas mass flow through the mill" + at,
+          fmt::format("{} kg/s", g3(d(f.at("inlet_mass_flow_kg_s")))) +
+              (num(pick(f, "mass_imbalance_relative"))
+                   ? (d(f.at("mass_imbalance_relative")) < 1e-4
+                          ? std::string(" (in/out differ by < 0.01%)")
+                          : fmt::format(" (in/out differ by {:.2g}%)", 100 * d(f.at("mass_imbalance_relative"))))
+                   : ""));
+    if (num(pick(f, "shaft_power_W")))
+      add(0, "flywheel shaft power (gas only)" + at,
+          fmt::format("{} kW", g3(d(f.at("shaft_power_W")) / 1000)) +
+              (num(pick(f, "shaft_torque_Nm")) ? fmt::format(" ({} N m)", g3(d(f.at("shaft_torque_Nm")))) : ""));
+    if (num(pick(f, "backflow_outlet_in_kg_s")) && num(pick(f, "backflow_inlet_out_kg_s")))
+      add(0, "backflow: in through the outlet, out through the inlet" + at,
+          fmt::format("{} / {} kg/s", g3(d(f.at("backflow_outlet_in_kg_s"))), g3(d(f.at("backflow_inlet_out_kg_s")))),
+          false);
+    if (num(pick(f, "iterations"))) {
+      std::string mesh;
+      if (pick(f, "domain").is_string()) mesh = f.at("domain").get<std::string>() + " domain";
+      if (num(pick(f, "cells")))
+        mesh += (mesh.empty() ? "" : ", ") + std::to_string(f.at("cells").get<long>()) + " cells";
+      add(0, "flow solution" + at,
+          fmt::format("{} {} iterations{}", pick(f, "converged") == true ? "converged in" : "not converged after",
+                      f.at("iterations").get<long>(), mesh.empty() ? "" : " (" + mesh + ")"),
+          false);
+    }
+    if (num(pick(f, "rim_gas_speed_to_tip_speed")))
+      add(0, "gas speed near the rim" + at, fmt::format("{:.2f} x the tip speed", d(f.at("rim_gas_speed_to_tip_speed"))),
+          false);
+  }
+
+  const json tr = pick(h, "transport");
+  for (const auto& rpm : rpm_keys(tr)) {
+    const json& t = tr.at(rpm);
+    const std::string at = ", " + rpm_words(rpm);
+    if (num(pick(t, "lumps")))
+      add(1, "lumps and their impacts" + at,
+          fmt::format("{} lumps: {} impacts on the flywheel, {} on the walls", t.at("lumps").get<long>(),
+                      num(pick(t, "flywheel_impacts")) ? t.at("flywheel_impacts").get<long>() : 0L,
+                      num(pick(t, "wall_impacts")) ? t.at("wall_impacts").get<long>() : 0L),
+          false);
+    if (num(pick(t, "flywheel_impact_speed_mean_m_s")))
+      add(1, "flywheel impact speed" + at,
+          fmt::format("{} m/s{}{}{}", speed(d(t.at("flywheel_impact_speed_mean_m_s"))),
+                      num(pick(t, "flywheel_impact_speed_std_m_s"))
+                          ? fmt::format(" ± {} (sd)", speed(d(t.at("flywheel_impact_speed_std_m_s"))))
+                          : "",
+                      num(pick(t, "flywheel_normal_speed_mean_m_s"))
+                          ? fmt::format(", normal part {} m/s", speed(d(t.at("flywheel_normal_speed_mean_m_s"))))
+                          : "",
+                      num(pick(t, "flywheel_angle_mean_deg"))
+                          ? fmt::format(", {:.0f} deg to the surface", d(t.at("flywheel_angle_mean_deg")))
+                          : ""));
+  }
+
+  const json cal = pick(h, "calibration");
+  if (cal.is_object()) {
+    if (pick(cal, "source") == "ore card") {
+      add(2, "bond parameters", "from the ore card's calibrated section (no fitting run)");
+    } else {
+      struct P {
+        const char* key;
+        const char* what;
+        double scale;
+        const char* unit;
+        bool brief;
+      };
+      for (const P& p : {P{"ucs", "calibrated UCS", 1e-6, "MPa", true},
+                         P{"tensile_strength", "calibrated tensile strength", 1e-6, "MPa", true},
+                         P{"youngs_modulus", "calibrated Young's modulus", 1e-9, "GPa", false},
+                         P{"poisson_ratio", "calibrated Poisson's ratio", 1, "", false}}) {
+        const json a = pick(pick(cal, "achieved"), p.key), t = pick(pick(cal, "targets"), p.key);
+        if (!num(a)) continue;
+        const json ok = pick(pick(cal, "within_tolerance"), p.key);
+        add(2, p.what,
+            fmt::format("{} of {}{}{}", g3(d(a) * p.scale), num(t) ? g3(d(t) * p.scale) : "?", *p.unit ? " " : "",
+                        p.unit) +
+                (ok.is_boolean() ? (ok.get<bool>() ? ": met" : ": not met") : ""),
+            p.brief);
+      }
+    }
+  }
+
+  const json crit = pick(pick(h, "breakage"), "critical_speed");
+  if (crit.is_array())
+    for (const auto& c : crit) {
+      const json thr = pick(c, "largest_fraction_threshold");
+      std::string what = "critical impact speed" + (num(thr) ? " (largest piece < " + percent(d(thr)) + ")" : "");
+      if (num(pick(c, "angle_deg"))) what += fmt::format(", {:g} deg", d(c.at("angle_deg")));
+      std::string v = "not reached in the sweep";
+      if (num(pick(c, "critical_velocity_m_s"))) {
+        v = speed(d(c.at("critical_velocity_m_s"))) + " m/s";
+        if (num(pick(c, "min_m_s")) && num(pick(c, "max_m_s")) && d(c.at("min_m_s")) < d(c.at("max_m_s")))
+          v += fmt::format(" ({}-{} over repeats)", speed(d(c.at("min_m_s"))), speed(d(c.at("max_m_s"))));
+      }
+      add(3, what, v);
+    }
+  const json jk = pick(pick(h, "breakage"), "jk");
+  json card = nullptr;
+  if (jk.is_array())
+    for (const auto& j : jk) {
+      std::string what = "JK breakage parameters";
+      if (num(pick(j, "angle_deg"))) what += fmt::format(", {:g} deg", d(j.at("angle_deg")));
+      if (pick(j, "fitted") == true) {
+        std::string v = fmt::format("A {}%, b {} t/kWh, A x b {}", g3(d(j.at("A_percent"))), g3(d(j.at("b_t_per_kWh"))),
+                                    g3(d(j.at("A_times_b"))));
+        const json ab = pick(pick(j, "over_repeats"), "A_times_b");
+        const json n = pick(j, "repeats_fitted");
+        if (num(n) && n.get<int>() > 1 && num(pick(ab, "min")))
+          v += fmt::format(" (A x b {}-{} over {} repeats)", g3(d(ab.at("min"))), g3(d(ab.at("max"))), n.get<int>());
+        add(3, what, v);
+      } else {
+        add(3, what, "not fitted: " + (pick(j, "reason").is_string() ? j.at("reason").get<std::string>() : std::string("?")));
+      }
+      if (pick(j, "ore_card").is_object()) card = j.at("ore_card");
+    }
+  if (card.is_object())
+    add(3, "JK breakage parameters measured (ore card)",
+        fmt::format("A {}%, b {} t/kWh, A x b {}", g3(d(card.at("A_percent"))), g3(d(card.at("b_t_per_kWh"))),
+                    g3(d(card.at("A_times_b")))));
+
+  const json prod = pick(h, "product");
+  for (const auto& rpm : rpm_keys(prod)) {
+    const json& p = prod.at(rpm);
+    const std::string at = ", " + rpm_words(rpm);
+    auto size = [&](const char* k) {
+      if (num(pick(p, k))) return g3(d(p[k])) + " mm";
+      if (num(pick(p, "finest_sieve_mm"))) return "< " + g3(d(p.at("finest_sieve_mm"))) + " mm";
+      return std::string("?");
+    };
+    if (p.contains("p80_mm")) add(4, "product P80" + at, size("p80_mm") + " (P50 " + size("p50_mm") + ")");
+    if (num(pick(p, "fully_shredded_mass_fraction")))
+      add(4, "fully shredded (single elements)" + at, percent(d(p.at("fully_shredded_mass_fraction"))) + " of the mass");
+    if (num(pick(p, "t10_percent")))
+      add(4, "t10 (finer than a tenth of the feed)" + at, fmt::format("{:.0f}%", d(p.at("t10_percent"))), false);
+    if (num(pick(p, "largest_piece_mass_fraction")))
+      add(4, "largest piece" + at,
+          percent(d(p.at("largest_piece_mass_fraction"))) + " of a lump (mean over the impact conditions)", false);
+  }
+  return rows;
+}
+
+}  // namespace mill::report

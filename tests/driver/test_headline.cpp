@@ -1,0 +1,90 @@
+// The report's headline in words and units, from hand-made headline numbers.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "report/headline.h"
+
+namespace {
+
+using mill::report::headline_rows;
+using mill::report::HeadlineRow;
+using nlohmann::json;
+
+// The value of the row `what`, or "" when there is none.
+std::string value_of(const std::vector<HeadlineRow>& rows, const std::string& what) {
+  for (const auto& r : rows)
+    if (r.what == what) return r.value;
+  return "";
+}
+
+TEST(Headline, SaysItInWordsAndUnitsWithTheSpread) {
+  const json h = json::parse(R"({
+    "flow": {"rpm2000": {"inlet_mass_flow_kg_s": 1.234, "mass_imbalance_relative": 0.004, "iterations": 742,
+                         "converged": true, "domain": "half", "cells": 38754, "shaft_power_W": 41500}},
+    "calibration": {"source": "fitted", "targets": {"ucs": 50e6, "tensile_strength": 5e6},
+                    "achieved": {"ucs": 20.04e6, "tensile_strength": 4.9e6},
+                    "within_tolerance": {"ucs": false, "tensile_strength": true}},
+    "breakage": {"critical_speed": [{"angle_deg": null, "critical_velocity_m_s": 66.2, "min_m_s": 65.1,
+                                     "max_m_s": 81.7, "largest_fraction_threshold": 0.05}],
+                 "jk": [{"angle_deg": 90, "fitted": true, "A_percent": 52.3, "b_t_per_kWh": 0.912,
+                         "A_times_b": 47.7, "repeats_fitted": 3,
+                         "over_repeats": {"A_times_b": {"min": 40.2, "max": 55.0}},
+                         "ore_card": {"A_percent": 60, "b_t_per_kWh": 0.8, "A_times_b": 48}}]},
+    "product": {"rpm1500": {"p80_mm": null, "p50_mm": null, "finest_sieve_mm": 2},
+                "rpm2000": {"p80_mm": 8.14, "p50_mm": 3.21, "fully_shredded_mass_fraction": 0.45}}})");
+  const auto rows = headline_rows(h);
+  EXPECT_EQ(value_of(rows, "gas mass flow through the mill, 2000 rpm"), "1.23 kg/s (in/out differ by 0.4%)");
+  EXPECT_EQ(value_of(rows, "flywheel shaft power (gas only), 2000 rpm"), "41.5 kW");
+  EXPECT_EQ(value_of(rows, "flow solution, 2000 rpm"), "converged in 742 iterations (half domain, 38754 cells)");
+  EXPECT_EQ(value_of(rows, "calibrated UCS"), "20 of 50 MPa: not met");
+  EXPECT_EQ(value_of(rows, "calibrated tensile strength"), "4.9 of 5 MPa: met");
+  EXPECT_EQ(value_of(rows, "critical impact speed (largest piece < 5%)"), "66 m/s (65-82 over repeats)");
+  EXPECT_EQ(value_of(rows, "JK breakage parameters, 90 deg"),
+            "A 52.3%, b 0.912 t/kWh, A x b 47.7 (A x b 40.2-55 over 3 repeats)");
+  EXPECT_EQ(value_of(rows, "JK breakage parameters measured (ore card)"), "A 60%, b 0.8 t/kWh, A x b 48");
+  EXPECT_EQ(value_of(rows, "product P80, 2000 rpm"), "8.14 mm (P50 3.21 mm)");
+  EXPECT_EQ(value_of(rows, "product P80, 1500 rpm"), "< 2 mm (P50 < 2 mm)");  // finer than the finest sieve
+  EXPECT_EQ(value_of(rows, "fully shredded (single elements), 2000 rpm"), "45% of the mass");
+  // Slower rotor speeds first; stage groups in pipeline order; no dotted keys.
+  size_t p1500 = 0, p2000 = 0;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (rows[i].what == "product P80, 1500 rpm") p1500 = i;
+    if (rows[i].what == "product P80, 2000 rpm") p2000 = i;
+    EXPECT_EQ(rows[i].what.find('_'), std::string::npos) << rows[i].what;
+  }
+  EXPECT_LT(p1500, p2000);
+  EXPECT_EQ(rows.front().group, "Gas flow (stage 1a)");
+}
+
+// The flow stage reports the shaft torque and power ("shaft") and the
+// backflow; without them there is no power line.
+TEST(Headline, ShaftPowerFromTheFlowReportWhenItHasIt) {
+  namespace fs = std::filesystem;
+  const fs::path run = fs::temp_directory_path() / ("mill_headline_" + std::to_string(getpid()));
+  fs::remove_all(run);
+  fs::create_directories(run / "flow/rpm1500");
+  fs::create_directories(run / "flow/rpm2000");
+  std::ofstream(run / "flow/rpm1500/flow_report.json")
+      << R"({"shaft": {"torque_Nm": 200.0, "power_W": 31416.0}, "backflow_kg_s": {"outlet_in": 0.012, "inlet_out": 0.0}})";
+  std::ofstream(run / "flow/rpm2000/flow_report.json") << R"({"iterations": 30, "converged": false})";
+  const json h = mill::report::headline_json(run);
+  EXPECT_NEAR(h.at("flow").at("rpm1500").at("shaft_power_W").get<double>(), 31416.0, 0.1);
+  const auto rows = headline_rows(h);
+  EXPECT_EQ(value_of(rows, "flywheel shaft power (gas only), 1500 rpm"), "31.4 kW (200 N m)");
+  EXPECT_EQ(value_of(rows, "backflow: in through the outlet, out through the inlet, 1500 rpm"), "0.012 / 0 kg/s");
+  EXPECT_EQ(value_of(rows, "flywheel shaft power (gas only), 2000 rpm"), "");
+  EXPECT_EQ(value_of(rows, "flow solution, 2000 rpm"), "not converged after 30 iterations");
+  EXPECT_TRUE(headline_rows(json::object()).empty());
+  fs::remove_all(run);
+}
+
+TEST(Headline, NoJkFitSaysWhy) {
+  const auto rows = headline_rows(json::parse(
+      R"({"breakage": {"jk": [{"angle_deg": null, "fitted": false, "reason": "t10 not resolved at any impact"}]}})"));
+  EXPECT_EQ(value_of(rows, "JK breakage parameters"), "not fitted: t10 not resolved at any impact");
+}
+
+}  // namespace
