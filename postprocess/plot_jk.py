@@ -17,7 +17,6 @@ Usage: plot_jk.py --points jk_points.csv --fit jk_fit.json --out DIR
 """
 
 import argparse
-import csv
 import json
 import os
 import sys
@@ -27,27 +26,14 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from plot_breakage import read_csv  # noqa: E402  (same folder: the results-CSV reader)
 
 POINT_COLUMNS = ("angle_deg", "velocity_m_s", "repeat", "ecs_kWh_t", "t10_percent", "t10_resolved")
 
 
 def read_points(path):
     """The rows of jk_points.csv as dicts of floats; exits naming a missing column or bad cell."""
-    try:
-        with open(path, newline="") as f:
-            reader = csv.DictReader(f)
-            missing = [c for c in POINT_COLUMNS if c not in (reader.fieldnames or [])]
-            if missing:
-                sys.exit(f"{path}: missing column(s) {', '.join(missing)}")
-            rows = []
-            for line_no, row in enumerate(reader, start=2):
-                try:
-                    rows.append({k: float(row[k]) for k in POINT_COLUMNS})
-                except (TypeError, ValueError):
-                    sys.exit(f"{path}:{line_no}: expected numbers in columns {', '.join(POINT_COLUMNS)}")
-            return rows
-    except OSError as e:
-        sys.exit(f"{path}: cannot read ({e.strerror})")
+    return read_csv(path, POINT_COLUMNS)
 
 
 def read_fit(path):
