@@ -65,7 +65,7 @@ std::vector<std::array<double, 2>> flywheel_profile(const MillGeometry& g) {
         {g.axis_x + radial * c - tangential * s, g.axis_height + radial * s + tangential * c});
   };
   for (int i = 0; i < g.n_plates; ++i) {
-    const double th = i * dtheta;
+    const double th = i * dtheta + g.rotor_angle;
     at(th, std::sqrt(rh * rh - t2 * t2), -t2);
     at(th, xtip, -t2);
     at(th, xtip, t2);

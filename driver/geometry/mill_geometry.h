@@ -39,6 +39,10 @@ struct MillGeometry {
   double inlet_x = 0.0, inlet_size = 0.3;            // square on the roof
   double outlet_x = 0.0, outlet_size = 0.4;          // square on the floor
   int arc_segments = 96;                             // facets of the hub circle
+  // Angular position of the flywheel [rad], counter-clockwise about +z: plate
+  // i points at i * 2 pi / n_plates + rotor_angle. 0 puts plate 0 along +x.
+  // Used for frozen-rotor positions (flow) and a flywheel caught mid-turn.
+  double rotor_angle = 0.0;
 
   // Read the mill.* keys of a case file and validate them.
   static MillGeometry from_config(const config::Document& doc);

@@ -110,3 +110,27 @@ TEST(MillGeometry, FitErrorsNameTheKey) {
     EXPECT_NE(std::string(e.what()).find("mill.inlet.center_x"), std::string::npos) << e.what();
   }
 }
+
+// rotor_angle turns the whole flywheel rigidly about the rotor axis: each
+// vertex is the angle-0 vertex rotated by the angle (1e-12 m), the surface
+// stays closed and its volume is the same (1e-12 relative).
+TEST(MillGeometry, RotorAngleTurnsTheFlywheelRigidly) {
+  MillGeometry g;
+  const auto s0 = flywheel_surface(g);
+  g.rotor_angle = 0.37;
+  const auto s1 = flywheel_surface(g);
+  ASSERT_EQ(s0.size(), s1.size());
+  EXPECT_TRUE(closed_and_oriented(s1));
+  EXPECT_NEAR(signed_volume(s1), signed_volume(s0), 1e-12 * signed_volume(s0));
+  const double c = std::cos(0.37), sn = std::sin(0.37);
+  auto turn = [&](const Vec3& p) {
+    const double dx = p[0] - g.axis_x, dy = p[1] - g.axis_height;
+    return Vec3{g.axis_x + c * dx - sn * dy, g.axis_height + sn * dx + c * dy, p[2]};
+  };
+  for (size_t k = 0; k < s0.size(); ++k)
+    for (auto [p, q] : {std::pair{s0[k].a, s1[k].a}, std::pair{s0[k].b, s1[k].b},
+                        std::pair{s0[k].c, s1[k].c}}) {
+      const Vec3 r = turn(p);
+      for (int d = 0; d < 3; ++d) ASSERT_NEAR(r[d], q[d], 1e-12) << "triangle " << k;
+    }
+}
