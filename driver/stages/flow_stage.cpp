@@ -11,6 +11,7 @@
 #include <csignal>
 #include <fstream>
 #include <regex>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -51,6 +52,12 @@ std::vector<std::string> last_data_line(const fs::path& file) {
   return out;
 }
 
+// True when f is the output file wanted: `ext` is an extension (".dat") or a
+// file name ("moment.dat").
+bool is_output_file(const fs::path& f, const std::string& ext) {
+  return ext.rfind('.', 0) == 0 ? f.extension() == ext : f.filename() == ext;
+}
+
 // The single .dat (or given-name) file of a function object's output, newest time folder.
 fs::path function_object_file(const fs::path& case_dir, const std::string& fo,
                               const std::string& ext) {
@@ -67,12 +74,66 @@ fs::path function_object_file(const fs::path& case_dir, const std::string& fo,
       continue;
     }
     for (const auto& f : fs::directory_iterator(t.path()))
-      if (f.path().extension() == ext && tv >= best_t) {
+      if (is_output_file(f.path(), ext) && tv >= best_t) {
         best = f.path();
         best_t = tv;
       }
   }
   return best;
+}
+
+// Column `col` of every data line of a function object's output over all its
+// time folders (a restarted solve starts a new folder), ordered by time
+// (brackets are ignored). Used for the history of mass flow and torque.
+std::vector<std::pair<double, double>> function_object_series(const fs::path& case_dir,
+                                                              const std::string& fo,
+                                                              const std::string& ext, size_t col) {
+  std::map<double, double> by_time;
+  const fs::path root = case_dir / "postProcessing" / fo;
+  if (!fs::exists(root)) return {};
+  for (const auto& t : fs::directory_iterator(root)) {
+    if (!t.is_directory()) continue;
+    for (const auto& f : fs::directory_iterator(t.path())) {
+      if (!is_output_file(f.path(), ext)) continue;
+      std::ifstream in(f.path());
+      std::string l;
+      while (std::getline(in, l)) {
+        if (l.empty() || l[0] == '#') continue;
+        for (char& c : l)
+          if (c == '(' || c == ')') c = ' ';
+        std::istringstream ss(l);
+        std::vector<double> v;
+        double x;
+        while (ss >> x) v.push_back(x);
+        if (v.size() > col) by_time[v[0]] = v[col];
+      }
+    }
+  }
+  return {by_time.begin(), by_time.end()};
+}
+
+// Min, max and mean of a series over its last `fraction` of iterations (at
+// least 20 values), scaled: how steady a reported figure was at the end.
+nlohmann::json tail_spread(const std::vector<std::pair<double, double>>& series, double scale,
+                           double fraction = 0.1) {
+  nlohmann::json out;
+  if (series.empty()) return out;
+  const size_t n = std::min(series.size(),
+                            std::max<size_t>(20, static_cast<size_t>(fraction * series.size())));
+  double lo = INFINITY, hi = -INFINITY, sum = 0;
+  for (size_t i = series.size() - n; i < series.size(); ++i) {
+    const double v = series[i].second * scale;
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+    sum += v;
+  }
+  out["from_iteration"] = series[series.size() - n].first;
+  out["to_iteration"] = series.back().first;
+  out["min"] = lo;
+  out["max"] = hi;
+  out["mean"] = sum / n;
+  out["spread_relative"] = sum != 0 ? (hi - lo) / std::abs(sum / n) : 0.0;
+  return out;
 }
 
 // Copy the template, skipping anything a previous hand run may have left.
@@ -150,6 +211,17 @@ MeshPreset mesh_preset(const std::string& name) {
     p.cell = 0.1;
     p.rotor_level = 2;
     p.surface_min = p.surface_max = p.feature_level = 3;
+  } else if (name == "medium") {
+    // Between quick and reference: background cells 1.4x the reference's,
+    // with the reference's layers and second-order momentum.
+    p.cell = 0.07;
+    p.rotor_level = 2;
+    p.surface_min = p.surface_max = p.feature_level = 3;
+    p.layers = true;
+    p.second_order = true;
+    p.n_layers = 3;
+    p.first_layer = 0.0008;
+    p.expansion = 1.3;
   } else if (name == "reference") {
     p.cell = 0.05;
     p.rotor_level = 2;
@@ -161,7 +233,7 @@ MeshPreset mesh_preset(const std::string& name) {
     p.expansion = 1.3;
   } else {
     throw std::invalid_argument("flow.mesh_preset: unknown preset '" + name +
-                                "' (tiny, quick, reference)");
+                                "' (tiny, quick, medium, reference)");
   }
   return p;
 }
@@ -208,7 +280,8 @@ SolverLog parse_solver_log(const fs::path& log) {
 }
 
 // All numbers of the case, with the keys they come from.
-std::string case_parameters(const config::Document& doc, double rpm, const MeshPreset& mp, int np) {
+std::string case_parameters(const config::Document& doc, double rpm, const MeshPreset& mp, int np,
+                            long end_iteration) {
   const auto g = geometry::MillGeometry::from_config(doc);
   const bool comp = doc.str("gas.model") == "compressible";
   const double rho = doc.real("gas.density"), mu = doc.real("gas.viscosity");
@@ -241,8 +314,9 @@ std::string case_parameters(const config::Document& doc, double rpm, const MeshP
        "    location    \"system\";\n    object      caseParameters;\n}\n\n";
   s += fmt::format(
       "// case file: {}, rotor.rpm = {:g}, flow.mesh_preset = {}, --np {}\n"
-      "// By hand: foamDictionary -entry omega -set 157.08 system/caseParameters\n\n",
-      fs::path(doc.file()).filename().string(), rpm, mp.name, np);
+      "// By hand: foamDictionary -entry omega -set 157.08 system/caseParameters\n"
+      "// Flywheel frozen at flow.rotor_angle = {:g} deg (constant/triSurface/flywheel.stl)\n\n",
+      fs::path(doc.file()).filename().string(), rpm, mp.name, np, doc.real("flow.rotor_angle"));
   s += fmt::format("solver          {};  // gas.model = {}\n",
                    comp ? "rhoSimpleFoam" : "simpleFoam", doc.str("gas.model"));
   s += fmt::format("nProcs          {};\nhierarchicalN   (1 {} 1);\n\n", np, np);
@@ -320,8 +394,11 @@ std::string case_parameters(const config::Document& doc, double rpm, const MeshP
       "{:.6g};\n\n",
       k0, om0, 0.07 * g.inlet_size);
   s += "// Solver control (flow.*)\n";
-  s += fmt::format("maxIterations   {};\nresidualTarget  {:g};\n",
-                   doc.integer("flow.max_iterations"), doc.real("flow.residual_target"));
+  s += fmt::format("maxIterations   {};{}\nresidualTarget  {:g};\n",
+                   end_iteration > 0 ? end_iteration : doc.integer("flow.max_iterations"),
+                   end_iteration > 0 ? "  // first-order start (flow.first_order_iterations)" : "",
+                   doc.real("flow.residual_target"));
+
   return s;
 }
 
@@ -388,11 +465,7 @@ double read_flux(const fs::path& case_dir, const std::string& fo) {
 // total_y total_z pressure_x ... viscous_z" (brackets, if any, are ignored).
 // Empty if missing.
 std::vector<double> read_moment(const fs::path& case_dir) {
-  fs::path f;
-  const fs::path root = case_dir / "postProcessing" / "flywheelForces";
-  if (fs::exists(root))
-    for (const auto& e : fs::recursive_directory_iterator(root))
-      if (e.path().filename() == "moment.dat") f = e.path();
+  const auto f = flow::function_object_file(case_dir, "flywheelForces", "moment.dat");
   if (f.empty()) return {};
   std::ifstream in(f);
   std::string l, last;
@@ -460,8 +533,11 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
   const double rpm = job.inputs.at("rotor.rpm").get<double>();
   const int np = std::max(1, ctx.opts.np);
   const std::string tag = "flow/" + job.label;
-  const auto geo = geometry::MillGeometry::from_config(doc);
-  const auto preset = flow::mesh_preset(doc.str("flow.mesh_preset"));
+  auto geo = geometry::MillGeometry::from_config(doc);
+  geo.rotor_angle = doc.real("flow.rotor_angle") * flow::kPi / 180.0;  // frozen-rotor position
+  auto preset = flow::mesh_preset(doc.str("flow.mesh_preset"));
+  if (doc.str("flow.momentum_scheme") != "preset")
+    preset.second_order = doc.str("flow.momentum_scheme") == "linearUpwind";
   const bool comp = doc.str("gas.model") == "compressible";
   const std::string solver = comp ? "rhoSimpleFoam" : "simpleFoam";
   const double omega = rpm * 2 * flow::kPi / 60.0;
@@ -521,21 +597,50 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
         fmt::format("{} iter {}/{} p {:.1e} U {:.1e}", solver, s.iterations, max_it, p, u),
         static_cast<double>(s.iterations) / max_it);
   };
-  try {
-    run_foam(ctx, tag, work, {solver}, np, poll);
-  } catch (const engine::EngineError& e) {
-    const auto s = flow::parse_solver_log(log);
-    if (s.fpe || s.nan || e.result.signal == SIGFPE)
-      throw std::runtime_error(fmt::format(
-          "the flow diverged at iteration {} (floating-point exception / NaN in {}); try a finer "
-          "flow.mesh_preset or check rotor.rpm and gas.outlet_pressure_drop; log: {}",
-          s.iterations, solver, log.string()));
-    throw;
+  auto solve = [&]() {
+    try {
+      run_foam(ctx, tag, work, {solver}, np, poll);
+    } catch (const engine::EngineError& e) {
+      const auto s = flow::parse_solver_log(log);
+      if (s.fpe || s.nan || e.result.signal == SIGFPE)
+        throw std::runtime_error(fmt::format(
+            "the flow diverged at iteration {} (floating-point exception / NaN in {}); try a finer "
+            "flow.mesh_preset or check rotor.rpm and gas.outlet_pressure_drop; log: {}",
+            s.iterations, solver, log.string()));
+      throw;
+    }
+  };
+  // Second-order presets start with first-order upwind momentum for
+  // flow.first_order_iterations, then restart from that state (the solver's
+  // startFrom latestTime) with the preset's scheme.
+  const long first_order =
+      preset.second_order ? std::min<long>(doc.integer("flow.first_order_iterations"), max_it) : 0;
+  double first_order_cpu = 0;
+  int first_order_done = 0;
+  if (first_order > 0) {
+    auto upwind = preset;
+    upwind.second_order = false;
+    jobs::atomic_write(work / "system" / "caseParameters",
+                       flow::case_parameters(doc, rpm, upwind, np, first_order));
+    solve();
+    const auto s1 = flow::parse_solver_log(log);
+    first_order_cpu = s1.cpu_seconds;
+    first_order_done = s1.iterations;
+    fs::rename(log, work / ("log." + solver + ".firstOrder"));
+    jobs::atomic_write(work / "system" / "caseParameters",
+                       flow::case_parameters(doc, rpm, preset, np));
+    ctx.progress.info(fmt::format("{}: first-order start: {} iterations (p {:.2g}); now {}", tag,
+                                  s1.iterations,
+                                  s1.initial_residual.count("p") ? s1.initial_residual.at("p") : NAN,
+                                  "second-order momentum"));
   }
+  if (first_order < max_it) solve();
+  else fs::rename(work / ("log." + solver + ".firstOrder"), log);
   const double solve_seconds = std::chrono::duration<double>(clock::now() - t1).count();
   if (np > 1) run_foam(ctx, tag, work, {"reconstructPar", "-latestTime"});
 
-  const auto s = flow::parse_solver_log(log);
+  auto s = flow::parse_solver_log(log);
+  s.cpu_seconds += first_order < max_it ? first_order_cpu : 0.0;
   const double p_res = s.initial_residual.count("p") ? s.initial_residual.at("p") : NAN;
   double u_res = 0;
   for (const char* c : {"Ux", "Uy", "Uz"})
@@ -568,13 +673,28 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
         "solved z >= 0 with a symmetryPlane at z = 0; mass_flow_kg_s and patch_area_m2 are for "
         "the whole mill (2 x the solved half, see solved_half); cells, rim and y_plus are of the "
         "solved half";
+  rep["rotor_angle_deg"] = doc.real("flow.rotor_angle");
   rep["iterations"] = s.iterations;
+  rep["momentum_scheme"] =
+      preset.second_order
+          ? (first_order > 0 ? fmt::format("upwind for {} iterations, then linearUpwind",
+                                            first_order_done)
+                             : std::string("linearUpwind"))
+          : std::string("upwind");
   rep["max_iterations"] = max_it;
   rep["residual_target"] = target;
   rep["converged"] = converged;
   rep["final_initial_residuals"] = s.initial_residual;
   rep["mass_flow_kg_s"] = {
       {"inlet_in", m_in}, {"outlet_out", m_out}, {"imbalance_relative", imbalance}};
+  // How steady the figures were at the end: min/max over the last tenth of
+  // the iterations (a converged solve has a spread near 0).
+  rep["history_last_tenth"] = {
+      {"mass_flow_inlet_kg_s",
+       flow::tail_spread(flow::function_object_series(work, "inletFlow", ".dat", 1), -to_mass * mirror)},
+      {"shaft_torque_Nm",
+       flow::tail_spread(flow::function_object_series(work, "flywheelForces", "moment.dat", 3),
+                   -mirror)}};
   // Backflow: phi summed with its sign (net) and as |phi| (sum of both
   // directions) gives each direction: inflow through the outlet, outflow
   // through the inlet (zero when the opening passes gas one way only).
@@ -602,6 +722,29 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
                      "aerodynamic torque of the gas on the flywheel (pressure + viscous, about "
                      "the axis) at the last iteration; the motor power the gas alone takes, "
                      "without ore, bearings or windage outside the housing"}};
+  }
+  // Energy balance (compressible): the rotor's work must leave as a total
+  // temperature rise of the through-flow, dT0 = P / (m cp), walls adiabatic.
+  if (comp && rep.contains("shaft")) {
+    const auto ti = flow::last_data_line(flow::function_object_file(work, "inletTemperature", ".dat"));
+    const auto to = flow::last_data_line(flow::function_object_file(work, "outletTemperature", ".dat"));
+    if (ti.size() >= 3 && to.size() >= 3) {
+      constexpr double cp = 1005.0;  // constant/thermophysicalProperties
+      const double t_in = std::stod(ti[1]), t_out = std::stod(to[1]);
+      const double t0_in = t_in + 0.5 * std::stod(ti[2]) / cp,
+                   t0_out = t_out + 0.5 * std::stod(to[2]) / cp;
+      const double expected = m_out > 0 ? rep["shaft"]["power_W"].get<double>() / (m_out * cp) : NAN;
+      rep["energy_balance"] = {
+          {"inlet_T_K", t_in},
+          {"outlet_T_K", t_out},
+          {"total_temperature_rise_K", t0_out - t0_in},
+          {"expected_rise_from_shaft_power_K", expected},
+          {"note",
+           "mass-flux-weighted over each opening; expected = shaft power / (mass flow x cp 1005 "
+           "J/kg/K) with adiabatic walls. rhoSimpleFoam's MRF transports the absolute total "
+           "enthalpy with the relative flux and has no Euler work term, so the rotor's work does "
+           "not enter the energy equation (docs/flow.md, \"Compressible gas\")"}};
+    }
   }
   const double a_in = read_patch_area(work, "inletFlow");
   const double a_out = read_patch_area(work, "outletFlow");

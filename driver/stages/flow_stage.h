@@ -64,8 +64,10 @@ struct SolverLog {
 SolverLog parse_solver_log(const std::filesystem::path& log);
 
 // Text of system/caseParameters for this case and rotor speed (all SI).
+// end_iteration > 0 replaces flow.max_iterations (the first-order start of a
+// second-order preset runs to flow.first_order_iterations).
 std::string case_parameters(const config::Document& doc, double rpm, const MeshPreset& preset,
-                            int np);
+                            int np, long end_iteration = -1);
 
 }  // namespace flow
 }  // namespace mill

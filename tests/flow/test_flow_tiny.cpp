@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "engine/runner.h"
+#include "geometry/mill_geometry.h"
 #include "postprocess/flow_field_io.h"
 #include "progress.h"
 #include "stages/flow_stage.h"
@@ -250,9 +251,69 @@ TEST(FlowTiny, CompressibleOnTwoRanksMeshRunSample) {
   EXPECT_EQ(rep["solver"], "rhoSimpleFoam");
   EXPECT_EQ(rep["np"], 2);
   EXPECT_TRUE(fs::exists(r.opts.output / "flow" / "rpm2000" / "case" / "processor1"));
+  // The energy balance of the openings is reported: temperatures near the
+  // gas.temperature of 293.15 K (within 30 K after 30 iterations) and the
+  // rise the shaft power would give.
+  ASSERT_TRUE(rep.contains("energy_balance")) << rep.dump(2);
+  const auto& eb = rep["energy_balance"];
+  for (const char* k : {"inlet_T_K", "outlet_T_K"})
+    EXPECT_NEAR(eb[k].get<double>(), 293.15, 30.0) << k;
+  EXPECT_TRUE(std::isfinite(eb["total_temperature_rise_K"].get<double>()));
+  EXPECT_TRUE(std::isfinite(eb["expected_rise_from_shaft_power_K"].get<double>()));
   r.run(sample);
   check_outputs(r.opts.output, false, 1.0, 1.4);
   check_half_domain(r.opts.output, 1.0);  // rhoSimpleFoam's phi is kg/s
+  fs::remove_all(r.opts.output);
+}
+
+// Second-order momentum started with first-order upwind: two solver runs,
+// the second restarting from the first's state, the scheme switched in
+// caseParameters; the report's history spans both; the flywheel is meshed
+// at flow.rotor_angle (the published STL is the angle-0 flywheel turned by
+// 20 deg about the axis, to 1e-9 m).
+TEST(FlowTiny, SecondOrderStartsWithFirstOrderAtAFrozenRotorAngle) {
+  StageRun r(kData / "tiny_second_order.yaml", 1);
+  FlowStage flow;
+  r.run(flow);
+  const fs::path out = r.opts.output / "flow" / "rpm2000";
+  const auto rep = read_json(out / "flow_report.json");
+  EXPECT_EQ(rep["iterations"].get<int>(), 30);
+  EXPECT_EQ(rep["momentum_scheme"], "upwind for 12 iterations, then linearUpwind");
+  EXPECT_EQ(rep["rotor_angle_deg"].get<double>(), 20.0);
+  auto last_time = [](const fs::path& log, bool first) {
+    std::ifstream in(log);
+    std::string l;
+    int t = -1;
+    while (std::getline(in, l))
+      if (l.rfind("Time = ", 0) == 0) {
+        t = std::stoi(l.substr(7));
+        if (first) return t;
+      }
+    return t;
+  };
+  EXPECT_EQ(last_time(out / "case" / "log.simpleFoam.firstOrder", false), 12);
+  EXPECT_EQ(last_time(out / "case" / "log.simpleFoam", true), 13);
+  std::ifstream cp(out / "case" / "system" / "caseParameters");
+  std::stringstream cps;
+  cps << cp.rdbuf();
+  EXPECT_NE(cps.str().find("divU            bounded Gauss linearUpwind grad(U)"), std::string::npos);
+  const auto& h = rep["history_last_tenth"]["mass_flow_inlet_kg_s"];
+  EXPECT_EQ(h["to_iteration"].get<double>(), 30.0);
+  EXPECT_EQ(h["from_iteration"].get<double>(), 11.0) << "20 values over both runs";
+  EXPECT_LE(h["min"].get<double>(), rep["mass_flow_kg_s"]["inlet_in"].get<double>());
+  EXPECT_GE(h["max"].get<double>(), rep["mass_flow_kg_s"]["inlet_in"].get<double>());
+  EXPECT_EQ(rep["history_last_tenth"]["shaft_torque_Nm"]["to_iteration"].get<double>(), 30.0);
+
+  auto g = geometry::MillGeometry::from_config(r.cfg.doc);
+  const auto flat = geometry::flywheel_surface(g);
+  const auto meshed = geometry::read_stl(out / "geometry" / "flywheel.stl");
+  ASSERT_EQ(meshed.size(), flat.size());
+  const double a = 20 * M_PI / 180, c = std::cos(a), sn = std::sin(a);
+  for (size_t k = 0; k < flat.size(); k += 7) {
+    const double dx = flat[k].a[0] - g.axis_x, dy = flat[k].a[1] - g.axis_height;
+    EXPECT_NEAR(meshed[k].a[0], g.axis_x + c * dx - sn * dy, 1e-9);
+    EXPECT_NEAR(meshed[k].a[1], g.axis_height + sn * dx + c * dy, 1e-9);
+  }
   fs::remove_all(r.opts.output);
 }
 
