@@ -116,8 +116,8 @@ Schema make_case_schema() {
       positive(key("rotor.rpm", T::RealList, "rpm", "[2000]", "Rotor speeds; one flow/transport run per speed")),
 
       // --- gas ---
-      choice("gas.model", "incompressible", {"incompressible", "compressible"},
-             "simpleFoam (incompressible) or rhoSimpleFoam (air as a perfect gas)"),
+      choice("gas.model", "compressible", {"incompressible", "compressible"},
+             "rhoSimpleFoam (air as a perfect gas, the method's model; its temperature carries no rotor work, see docs/flow.md \"Compressible gas\") or simpleFoam (constant density gas.density)"),
       positive(key("gas.density", T::Real, "kg/m^3", "1.2", "Gas density (incompressible model; reference for drag)")),
       positive(key("gas.viscosity", T::Real, "Pa s", "1.8e-5", "Gas dynamic viscosity")),
       positive(key("gas.temperature", T::Real, "K", "293.15", "Gas temperature (compressible model)")),
