@@ -95,6 +95,16 @@ json headline_json(const fs::path& run, Problems* problems) {
     const json back = pick(f, "backflow_kg_s");
     if (num(pick(back, "outlet_in"))) e["backflow_outlet_in_kg_s"] = pick(back, "outlet_in");
     if (num(pick(back, "inlet_out"))) e["backflow_inlet_out_kg_s"] = pick(back, "inlet_out");
+    // How settled the mass flow was (last tenth of the iterations) and, for
+    // the compressible gas, the energy balance of the openings.
+    const json spread = pick(pick(pick(f, "history_last_tenth"), "mass_flow_inlet_kg_s"), "spread_relative");
+    if (num(spread)) e["mass_flow_spread_last_tenth"] = spread;
+    e["gas_model"] = pick(f, "gas_model");
+    const json eb = pick(f, "energy_balance");
+    if (num(pick(eb, "total_temperature_rise_K")) && num(pick(eb, "expected_rise_from_shaft_power_K"))) {
+      e["gas_temperature_rise_K"] = pick(eb, "total_temperature_rise_K");
+      e["gas_temperature_rise_adiabatic_K"] = pick(eb, "expected_rise_from_shaft_power_K");
+    }
     h["flow"][rpm] = e;
   }
   for (const auto& rpm : rpm_dirs(run / "transport")) {
@@ -173,7 +183,17 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
                    ? (d(f.at("mass_imbalance_relative")) < 1e-4
                           ? std::string(" (in/out differ by < 0.01%)")
                           : fmt::format(" (in/out differ by {:.2g}%)", 100 * d(f.at("mass_imbalance_relative"))))
+                   : "") +
+              (num(pick(f, "mass_flow_spread_last_tenth"))
+                   ? fmt::format("; varied by {:.2g}% over the last tenth of the iterations",
+                                 100 * d(f.at("mass_flow_spread_last_tenth")))
                    : ""));
+    if (num(pick(f, "gas_temperature_rise_K")) && num(pick(f, "gas_temperature_rise_adiabatic_K")))
+      add(0, "gas heating (not predicted)" + at,
+          fmt::format("solved {} K; the shaft power would heat the gas by {} K with adiabatic walls, "
+                      "but the rotor's work does not enter the solver's energy equation (docs/flow.md)",
+                      g3(d(f.at("gas_temperature_rise_K"))), g3(d(f.at("gas_temperature_rise_adiabatic_K")))),
+          false);
     if (num(pick(f, "shaft_power_W")))
       add(0, "flywheel shaft power (gas only)" + at,
           fmt::format("{} kW", g3(d(f.at("shaft_power_W")) / 1000)) +

@@ -68,13 +68,23 @@ TEST(Headline, ShaftPowerFromTheFlowReportWhenItHasIt) {
   fs::create_directories(run / "flow/rpm1500");
   fs::create_directories(run / "flow/rpm2000");
   std::ofstream(run / "flow/rpm1500/flow_report.json")
-      << R"({"shaft": {"torque_Nm": 200.0, "power_W": 31416.0}, "backflow_kg_s": {"outlet_in": 0.012, "inlet_out": 0.0}})";
+      << R"({"shaft": {"torque_Nm": 200.0, "power_W": 31416.0}, "backflow_kg_s": {"outlet_in": 0.012, "inlet_out": 0.0},
+            "mass_flow_kg_s": {"inlet_in": 0.7763, "imbalance_relative": 1e-6},
+            "history_last_tenth": {"mass_flow_inlet_kg_s": {"spread_relative": 0.0061}},
+            "energy_balance": {"total_temperature_rise_K": 1.184, "expected_rise_from_shaft_power_K": 189.06}})";
   std::ofstream(run / "flow/rpm2000/flow_report.json") << R"({"iterations": 30, "converged": false})";
   const json h = mill::report::headline_json(run);
   EXPECT_NEAR(h.at("flow").at("rpm1500").at("shaft_power_W").get<double>(), 31416.0, 0.1);
   const auto rows = headline_rows(h);
   EXPECT_EQ(value_of(rows, "flywheel shaft power (gas only), 1500 rpm"), "31.4 kW (200 N m)");
   EXPECT_EQ(value_of(rows, "backflow: in through the outlet, out through the inlet, 1500 rpm"), "0.012 / 0 kg/s");
+  // How settled the mass flow was, and the gas heating the solver leaves out.
+  EXPECT_EQ(value_of(rows, "gas mass flow through the mill, 1500 rpm"),
+            "0.776 kg/s (in/out differ by < 0.01%); varied by 0.61% over the last tenth of the iterations");
+  EXPECT_EQ(value_of(rows, "gas heating (not predicted), 1500 rpm"),
+            "solved 1.18 K; the shaft power would heat the gas by 189 K with adiabatic walls, but the rotor's "
+            "work does not enter the solver's energy equation (docs/flow.md)");
+  EXPECT_EQ(value_of(rows, "gas heating (not predicted), 2000 rpm"), "");
   EXPECT_EQ(value_of(rows, "flywheel shaft power (gas only), 2000 rpm"), "");
   EXPECT_EQ(value_of(rows, "flow solution, 2000 rpm"), "not converged after 30 iterations");
   EXPECT_TRUE(headline_rows(json::object()).empty());

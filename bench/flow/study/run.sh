@@ -21,7 +21,9 @@ sed -e "s/^  mesh_preset: quick/  mesh_preset: $preset\n  rotor_angle: $angle/" 
     -e "s/^name: flow_study/name: flow_study_${preset}_a${angle}_${gas}/" \
     "$root/bench/flow/study/base.yaml" > "$case_file"
 for stage in flow sample transport; do
+  np=1
+  [ "$stage" = flow ] && np=${NP:-1}   # NP=2 bench/flow/study/run.sh reference 0: the CFD on 2 ranks
   /usr/bin/time -f "$stage: wall %e s, user %U s, max RSS %M kB" \
-    "$exe" --case "$case_file" --stage "$stage" --output "$out" 2>&1 | tail -n 3
+    "$exe" --case "$case_file" --stage "$stage" --np "$np" --output "$out" 2>&1 | tail -n 3
 done
 echo "results: $out/{flow,sample,transport}/rpm2000"
