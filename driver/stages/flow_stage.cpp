@@ -378,6 +378,9 @@ std::string case_parameters(const config::Document& doc, double rpm, const MeshP
       rho, mu / rho, mu, doc.real("gas.temperature"));
   // forces function object: rho from the field (rhoSimpleFoam) or rhoRef
   // times the kinematic pressure (simpleFoam)
+  // limits of the start-up temperature guard (system/fvOptions, compressible)
+  s += fmt::format("TMinLimit       {:.10g};\nTMaxLimit       {:.10g};\n",
+                   0.5 * doc.real("gas.temperature"), 3.0 * doc.real("gas.temperature"));
   s += fmt::format("forcesRho       {};\n", comp ? "rho" : "rhoInf");
   if (comp) {
     s += "pDims           [1 -1 -2 0 0 0 0];  // Pa, absolute\n";
@@ -745,6 +748,30 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
            "MRF zone, so the rotor's work does not enter the energy equation: the rise is near "
            "0 instead (measured 1.2 K against 189 K on the quick mesh), and T is not a heat "
            "balance; docs/flow.md, \"Compressible gas\""}};
+    }
+  }
+  // Temperature range of the gas (compressible) against the start-up guard
+  // of system/fvOptions: a guard still clipping at the end is reported.
+  if (comp) {
+    const auto tmin = flow::last_data_line(flow::function_object_file(work, "minTemperature", ".dat"));
+    const auto tmax = flow::last_data_line(flow::function_object_file(work, "maxTemperature", ".dat"));
+    if (tmin.size() >= 2 && tmax.size() >= 2) {
+      const double t_ref = doc.real("gas.temperature");
+      const double lo = std::stod(tmin[1]), hi = std::stod(tmax[1]);
+      const bool clipped = lo <= 0.5 * t_ref * 1.0001 || hi >= 3.0 * t_ref * 0.9999;
+      rep["temperature_K"] = {{"min", lo},
+                              {"max", hi},
+                              {"guard_limits", {0.5 * t_ref, 3.0 * t_ref}},
+                              {"guard_clipping_at_end", clipped},
+                              {"note",
+                               "lowest and highest T in the gas at the last iteration; the guard "
+                               "(system/fvOptions limitT) only holds the first iterations of the "
+                               "layered meshes and must not clip at the end"}};
+      if (clipped)
+        ctx.progress.warn(fmt::format(
+            "{}: the temperature guard still clips at the last iteration (T {:.1f}-{:.1f} K, "
+            "limits {:.1f}-{:.1f} K): the solution is not trustworthy; see docs/flow.md",
+            tag, lo, hi, 0.5 * t_ref, 3.0 * t_ref));
     }
   }
   const double a_in = read_patch_area(work, "inletFlow");

@@ -260,6 +260,16 @@ TEST(FlowTiny, CompressibleOnTwoRanksMeshRunSample) {
     EXPECT_NEAR(eb[k].get<double>(), 293.15, 30.0) << k;
   EXPECT_TRUE(std::isfinite(eb["total_temperature_rise_K"].get<double>()));
   EXPECT_TRUE(std::isfinite(eb["expected_rise_from_shaft_power_K"].get<double>()));
+  // The gas's temperature range and the start-up guard (system/fvOptions):
+  // limits TRef / 2 and 3 TRef, and the guard does not clip at the end.
+  ASSERT_TRUE(rep.contains("temperature_K")) << rep.dump(2);
+  const auto& tk = rep["temperature_K"];
+  EXPECT_NEAR(tk["guard_limits"][0].get<double>(), 0.5 * 293.15, 1e-9);
+  EXPECT_NEAR(tk["guard_limits"][1].get<double>(), 3.0 * 293.15, 1e-9);
+  EXPECT_LE(tk["min"].get<double>(), tk["max"].get<double>());
+  EXPECT_NEAR(tk["min"].get<double>(), 293.15, 30.0);
+  EXPECT_NEAR(tk["max"].get<double>(), 293.15, 30.0);
+  EXPECT_FALSE(tk["guard_clipping_at_end"].get<bool>());
   r.run(sample);
   check_outputs(r.opts.output, false, 1.0, 1.4);
   check_half_domain(r.opts.output, 1.0);  // rhoSimpleFoam's phi is kg/s
