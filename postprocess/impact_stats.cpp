@@ -90,6 +90,11 @@ CsvTable read_csv_table(const std::string& path, const std::vector<const char*>&
 
 constexpr const char* kAxes[3] = {"x", "y", "z"};
 
+// The surface codes of transport.h5 (attribute surface_codes).
+long long surface_code(const std::string& surface) {
+  return surface == "flywheel" ? 0 : surface == "housing" ? 1 : 2;
+}
+
 // Owns an HDF5 id and closes it with the matching close function.
 class H5Handle {
  public:
@@ -544,7 +549,7 @@ void WriteTransportH5(const std::string& path, const std::vector<ImpactRecord>& 
       for (const auto& r : records) {
         t.push_back(r.time_s);
         id.push_back(r.particle_id);
-        code.push_back(r.surface == "flywheel" ? 0 : r.surface == "housing" ? 1 : 2);
+        code.push_back(surface_code(r.surface));
         pos.push_back(r.position);
         con.push_back(r.contact);
         nrm.push_back(r.normal);
@@ -595,7 +600,7 @@ void WriteTransportH5(const std::string& path, const std::vector<ImpactRecord>& 
       for (const auto& e : ends) {
         t.push_back(e.time_s);
         id.push_back(e.particle_id);
-        code.push_back(e.surface == "flywheel" ? 0 : e.surface == "housing" ? 1 : 2);
+        code.push_back(surface_code(e.surface));
         t0.push_back(e.start_time_s);
         dur.push_back(e.duration_s);
         vel.push_back(e.velocity);

@@ -94,6 +94,16 @@ def trajectories(f, geo, out, max_lumps=40, span=0.3):
     plt.close(fig)
 
 
+def finish(fig, ax, xlabel, title, path):
+    """Labels a histogram's axes and title and saves it."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("count")
+    ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
 def histogram(values, xlabel, title, path, bins=30, discrete=False):
     """One histogram PNG; says so when there is nothing to plot."""
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -107,12 +117,7 @@ def histogram(values, xlabel, title, path, bins=30, discrete=False):
         ax.legend()
     else:
         ax.text(0.5, 0.5, "no impacts", ha="center", va="center", transform=ax.transAxes)
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel("count")
-    ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    finish(fig, ax, xlabel, title, path)
 
 
 def overlaid(groups, xlabel, title, path, bins=30):
@@ -128,12 +133,7 @@ def overlaid(groups, xlabel, title, path, bins=30):
         ax.legend(fontsize=8)
     else:
         ax.text(0.5, 0.5, "no strikes", ha="center", va="center", transform=ax.transAxes)
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel("count")
-    ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    finish(fig, ax, xlabel, title, path)
 
 
 def finite(a):
