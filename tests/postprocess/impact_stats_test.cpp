@@ -130,7 +130,15 @@ TEST(TrajectoryDump, ReadsSnapshotsOnce) {
 
 TEST(TransportH5, DatasetsCarryUnits) {
   const std::vector<double> insert = {0.0};
-  const std::vector<ImpactRecord> r = {rec(1, "flywheel", 0.3, 90, 80, 60)};
+  std::vector<ImpactRecord> r = {rec(1, "flywheel", 0.3, 90, 80, 60)};
+  LabelImpacts(r, MillShape{}, 1.0);
+  ContactEnd e;
+  e.particle_id = 1;
+  e.surface = "flywheel";
+  e.start_time_s = 0.3;
+  e.time_s = 0.30006;
+  e.speed_m_s = 120;
+  const std::vector<ContactEnd> ends = {e};
   Trajectories tr;
   tr.time_s = {0.0};
   tr.particle_id = {1};
@@ -141,11 +149,16 @@ TEST(TransportH5, DatasetsCarryUnits) {
   meta.units = {{"rpm", "1/min"}};
   meta.geometry = {{"tip_radius", 0.5}};
   const fs::path p = fs::temp_directory_path() / ("transport_" + std::to_string(getpid()) + ".h5");
-  WriteTransportH5(p.string(), r, ComputeTransportStats(r, insert), insert, tr, meta);
+  WriteTransportH5(p.string(), r, ComputeTransportStats(r, insert, ends), insert, tr, meta, ends);
   EXPECT_EQ(dataset_unit(p, "impacts/speed"), "m/s");
   EXPECT_EQ(dataset_unit(p, "impacts/angle"), "deg");
   EXPECT_EQ(dataset_unit(p, "particles/first_impact_time"), "s");
   EXPECT_EQ(dataset_unit(p, "trajectories/speed"), "m/s");
+  EXPECT_EQ(dataset_unit(p, "strikes/rebound_speed_lab"), "m/s");
+  EXPECT_EQ(dataset_unit(p, "strikes/flight_time"), "s");
+  EXPECT_EQ(dataset_unit(p, "strikes/housing_angle"), "deg");
+  EXPECT_EQ(dataset_unit(p, "contact_ends/velocity"), "m/s");
+  EXPECT_EQ(dataset_unit(p, "impacts/part"), "1");
   fs::remove(p);
 }
 
