@@ -1,5 +1,6 @@
 // fix impact/recorder: contact onsets between particles and wall meshes, with
-// the impact velocity relative to the (possibly rotating) struck surface.
+// the impact velocity relative to the (possibly rotating) struck surface, and
+// contact ends with the lab velocity after the contact and its duration.
 // See docs/styles/fix_impact_recorder.md for keywords, columns and units.
 #include "fix_impact_recorder.h"
 
@@ -97,7 +98,7 @@ void closest_on_triangle(const double *p, const double *a, const double *b, cons
 
 /* ---------------------------------------------------------------------- */
 
-// Parses keywords, opens the CSV (rank 0) and registers the per-atom state.
+// Parses keywords, opens the CSVs (rank 0) and registers the per-atom state.
 FixImpactRecorder::FixImpactRecorder(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg) {
   parse_args(narg, arg);
   vector_flag = 1;
@@ -107,16 +108,20 @@ FixImpactRecorder::FixImpactRecorder(LAMMPS *lmp, int narg, char **arg) : Fix(lm
   create_attribute = 1;
   counts_.assign(size_vector, 0.0);
 
+  ncols_ = 1 + static_cast<int>(surfaces_.size());
   grow_arrays(atom->nmax);
   atom->add_callback(0);
-  for (int i = 0; i < atom->nmax; ++i) state_[i] = 0.0;
 
   if (comm->me == 0) {
-    file_ = fopen(file_path_.c_str(), "w");
-    if (!file_) {
-      const std::string msg = "fix impact/recorder: cannot open file '" + file_path_ + "'";
-      error->one(FLERR, msg.c_str());
-    }
+    auto open = [this](const std::string &path) {
+      FILE *f = fopen(path.c_str(), "w");
+      if (!f) {
+        const std::string msg = "fix impact/recorder: cannot open file '" + path + "'";
+        error->one(FLERR, msg.c_str());
+      }
+      return f;
+    };
+    file_ = open(file_path_);
     fputs(
         "time_s,particle_id,surface,x_m,y_m,z_m,contact_x_m,contact_y_m,contact_z_m,"
         "normal_x,normal_y,normal_z,vrel_x_m_s,vrel_y_m_s,vrel_z_m_s,speed_m_s,"
@@ -124,17 +129,27 @@ FixImpactRecorder::FixImpactRecorder(LAMMPS *lmp, int narg, char **arg) : Fix(lm
         "particle_speed_m_s,axis_distance_m\n",
         file_);
     fflush(file_);
+    if (!ends_path_.empty()) {
+      ends_file_ = open(ends_path_);
+      fputs(
+          "time_s,particle_id,surface,start_time_s,duration_s,x_m,y_m,z_m,vx_m_s,vy_m_s,vz_m_s,"
+          "speed_m_s,vrel_x_m_s,vrel_y_m_s,vrel_z_m_s,relative_speed_m_s,normal_speed_m_s,"
+          "tangential_speed_m_s,surface_speed_m_s\n",
+          ends_file_);
+      fflush(ends_file_);
+    }
   }
 }
 
-// Unregisters the callback, frees storage and closes the CSV.
+// Unregisters the callback, frees storage and closes the CSVs.
 FixImpactRecorder::~FixImpactRecorder() {
   atom->delete_callback(id, 0);
   memory->destroy(state_);
   if (file_) fclose(file_);
+  if (ends_file_) fclose(ends_file_);
 }
 
-// Reads `fix ID group impact/recorder file F surface NAME mesh MESHID
+// Reads `fix ID group impact/recorder file F [ends F2] surface NAME mesh MESHID
 // [omega w origin x y z axis x y z] [surface ...]`; errors name key and value.
 void FixImpactRecorder::parse_args(int narg, char **arg) {
   auto fail = [this](const std::string &msg) {
@@ -152,6 +167,10 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
       need(iarg, 1, key);
       file_path_ = arg[iarg + 1];
       iarg += 2;
+    } else if (key == "ends") {
+      need(iarg, 1, key);
+      ends_path_ = arg[iarg + 1];
+      iarg += 2;
     } else if (key == "surface") {
       need(iarg, 3, key);
       if (std::strcmp(arg[iarg + 2], "mesh") != 0)
@@ -163,7 +182,7 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
       iarg += 4;
       bool have_omega = false, have_origin = false, have_axis = false;
       while (iarg < narg && std::strcmp(arg[iarg], "surface") != 0 &&
-             std::strcmp(arg[iarg], "file") != 0) {
+             std::strcmp(arg[iarg], "file") != 0 && std::strcmp(arg[iarg], "ends") != 0) {
         const std::string sub = arg[iarg];
         if (sub == "omega") {
           need(iarg, 1, sub);
@@ -178,7 +197,7 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
           iarg += 4;
         } else {
           fail("surface " + s.name + ": unknown keyword '" + sub +
-               "' (expected omega, origin, axis, surface, file)");
+               "' (expected omega, origin, axis, surface, file, ends)");
         }
       }
       if (have_omega || have_origin || have_axis) {
@@ -192,10 +211,13 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
       }
       surfaces_.push_back(s);
     } else {
-      fail("unknown keyword '" + key + "' (expected file, surface)");
+      fail("unknown keyword '" + key + "' (expected file, ends, surface)");
     }
   }
   if (file_path_.empty()) fail("keyword 'file' (the impact CSV) is required");
+  if (!ends_path_.empty() && ends_path_ == file_path_)
+    fail("'ends' and 'file' name the same file '" + file_path_ +
+         "'; give the contact ends their own");
   if (surfaces_.empty()) fail("at least one 'surface NAME mesh MESH_FIX_ID' is required");
   if (surfaces_.size() > static_cast<size_t>(kMaxSurfaces))
     fail("at most " + std::to_string(kMaxSurfaces) + " surfaces, got " +
@@ -229,7 +251,8 @@ void FixImpactRecorder::init() {
 }
 
 // Marks particles already touching a surface at the start as in contact
-// (no record): only onsets during the run are impacts.
+// (no record, and no end record later): only onsets during the run are
+// impacts. Called at every `run`; contacts already known keep their state.
 void FixImpactRecorder::setup(int /*vflag*/) {
   double **x = atom->x;
   const double *radius = atom->radius;
@@ -240,12 +263,15 @@ void FixImpactRecorder::setup(int /*vflag*/) {
   }
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
-    int bits = static_cast<int>(state_[i]);
+    int bits = static_cast<int>(state_[i][0]);
     for (size_t is = 0; is < surfaces_.size(); ++is) {
       double c[3];
-      if (nearest_point(surfaces_[is], x[i], radius[i], c)) bits |= 1 << is;
+      if (!(bits & (1 << is)) && nearest_point(surfaces_[is], x[i], radius[i], c)) {
+        bits |= 1 << is;
+        state_[i][1 + is] = -1.0;
+      }
     }
-    state_[i] = bits;
+    state_[i][0] = bits;
   }
 }
 
@@ -348,6 +374,24 @@ bool FixImpactRecorder::nearest_point(Surface &s, const double *x, double radius
   return found;
 }
 
+// Velocity w of surface s at point c (Omega x r, r from the axis to c; zero
+// for a fixed surface) and the distance of c from the axis.
+void FixImpactRecorder::surface_velocity(const Surface &s, const double *c, double *w,
+                                         double *raxis) const {
+  for (int k = 0; k < 3; ++k) w[k] = 0.0;
+  *raxis = 0.0;
+  if (!s.rotating) return;
+  double r[3], om[3];
+  sub3(c, s.origin.data(), r);
+  const double along = dot3(r, s.axis.data());
+  for (int k = 0; k < 3; ++k) {
+    r[k] -= along * s.axis[k];  // radius vector from the axis
+    om[k] = s.omega * s.axis[k];
+  }
+  *raxis = std::sqrt(dot3(r, r));
+  cross3(om, r, w);
+}
+
 // Stores one onset of atom i on surface is at contact point c: velocity
 // relative to the surface there (v - Omega x r for a rotating surface), its
 // normal and tangential parts, and the impact angle to the surface plane.
@@ -362,18 +406,8 @@ void FixImpactRecorder::record(const Surface &s, int is, int i, const double *c)
   sub3(x[i], c, n);
   const double len = std::sqrt(dot3(n, n));
   for (int k = 0; k < 3; ++k) n[k] = len > 0.0 ? n[k] / len : 0.0;
-  double w[3] = {0.0, 0.0, 0.0}, raxis = 0.0;
-  if (s.rotating) {
-    double r[3], om[3];
-    sub3(c, s.origin.data(), r);
-    const double along = dot3(r, s.axis.data());
-    for (int k = 0; k < 3; ++k) {
-      r[k] -= along * s.axis[k];  // radius vector from the axis
-      om[k] = s.omega * s.axis[k];
-    }
-    raxis = std::sqrt(dot3(r, r));
-    cross3(om, r, w);  // surface velocity Omega x r
-  }
+  double w[3], raxis;
+  surface_velocity(s, c, w, &raxis);
   double vr[3];
   sub3(vpre, w, vr);
   const double vn = -dot3(vr, n);  // approach speed along the normal (> 0 towards the surface)
@@ -405,8 +439,54 @@ void FixImpactRecorder::record(const Surface &s, int is, int i, const double *c)
   events_.insert(events_.end(), e, e + NCOL);
 }
 
-// Detects onsets after the step's integration (particles and meshes at the
-// same time), then gathers the step's records on rank 0 (one reduction).
+// Stores the end of the contact of atom i with surface is that began at
+// `start`: the lab velocity now (the first step without contact, so no
+// contact force is in it) and, at the nearest surface point within two radii,
+// the velocity relative to the surface with its normal (> 0 away from the
+// surface) and tangential parts.
+void FixImpactRecorder::record_end(Surface &s, int is, int i, double start) {
+  double **x = atom->x, **v = atom->v;
+  const double now = update->get_cur_time();
+  double c[3], w[3] = {0, 0, 0}, raxis = 0.0, vr[3], n[3] = {0, 0, 0};
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  double vn = nan, vt = nan, wspeed = nan;
+  for (int k = 0; k < 3; ++k) vr[k] = nan;
+  if (nearest_point(s, x[i], 2.0 * atom->radius[i], c)) {
+    surface_velocity(s, c, w, &raxis);
+    sub3(x[i], c, n);
+    const double len = std::sqrt(dot3(n, n));
+    for (int k = 0; k < 3; ++k) n[k] = len > 0.0 ? n[k] / len : 0.0;
+    sub3(v[i], w, vr);
+    vn = dot3(vr, n);
+    double t[3];
+    for (int k = 0; k < 3; ++k) t[k] = vr[k] - vn * n[k];
+    vt = std::sqrt(dot3(t, t));
+    wspeed = std::sqrt(dot3(w, w));
+  }
+  const double e[NEND] = {now,
+                          static_cast<double>(atom->tag[i]),
+                          static_cast<double>(is),
+                          start,
+                          now - start,
+                          x[i][0],
+                          x[i][1],
+                          x[i][2],
+                          v[i][0],
+                          v[i][1],
+                          v[i][2],
+                          std::sqrt(dot3(v[i], v[i])),
+                          vr[0],
+                          vr[1],
+                          vr[2],
+                          std::sqrt(dot3(vr, vr)),
+                          vn,
+                          vt,
+                          wspeed};
+  ends_.insert(ends_.end(), e, e + NEND);
+}
+
+// Detects onsets and ends after the step's integration (particles and meshes
+// at the same time), then gathers the step's records on rank 0 (one reduction).
 void FixImpactRecorder::end_of_step() {
   double **x = atom->x;
   const double *radius = atom->radius;
@@ -414,44 +494,71 @@ void FixImpactRecorder::end_of_step() {
   for (auto &s : surfaces_) s.loaded = false;  // triangles are fetched lazily
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
-    int bits = static_cast<int>(state_[i]);
+    int bits = static_cast<int>(state_[i][0]);
     for (size_t is = 0; is < surfaces_.size(); ++is) {
       double c[3];
       const int bit = 1 << is;
       if (nearest_point(surfaces_[is], x[i], radius[i], c)) {
-        if (!(bits & bit)) record(surfaces_[is], static_cast<int>(is), i, c);
+        if (!(bits & bit)) {
+          record(surfaces_[is], static_cast<int>(is), i, c);
+          state_[i][1 + is] = update->get_cur_time();
+        }
         bits |= bit;
       } else {
+        if ((bits & bit) && !ends_path_.empty() && state_[i][1 + is] >= 0.0)
+          record_end(surfaces_[is], static_cast<int>(is), i, state_[i][1 + is]);
         bits &= ~bit;
+        state_[i][1 + is] = -1.0;
       }
     }
-    state_[i] = bits;
+    state_[i][0] = bits;
   }
   flush_events();
 }
 
-// Gathers this step's records to rank 0, appends them to the CSV and updates
-// the cached counts.
-void FixImpactRecorder::flush_events() {
-  const int nlocal_ev = static_cast<int>(events_.size() / NCOL);
-  int ntotal = 0;
-  MPI_Allreduce(&nlocal_ev, &ntotal, 1, MPI_INT, MPI_SUM, world);
-  if (ntotal == 0) return;
+// Moves this step's records of every rank (ncol values each, ntotal in all)
+// to rank 0; `local` is emptied.
+std::vector<double> FixImpactRecorder::gather(std::vector<double> &local, int ncol, int ntotal) {
   std::vector<double> all;
   if (comm->nprocs == 1) {
-    all.swap(events_);
-  } else {
-    const int nsend = nlocal_ev * NCOL;
-    std::vector<int> counts(comm->nprocs), displs(comm->nprocs);
-    MPI_Gather(&nsend, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
-    if (comm->me == 0) {
-      for (int p = 1; p < comm->nprocs; ++p) displs[p] = displs[p - 1] + counts[p - 1];
-      all.resize(static_cast<size_t>(ntotal) * NCOL);
-    }
-    MPI_Gatherv(events_.data(), nsend, MPI_DOUBLE, all.data(), counts.data(), displs.data(),
-                MPI_DOUBLE, 0, world);
+    all.swap(local);
+    return all;
   }
-  events_.clear();
+  const int nsend = static_cast<int>(local.size());
+  std::vector<int> counts(comm->nprocs), displs(comm->nprocs);
+  MPI_Gather(&nsend, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
+  if (comm->me == 0) {
+    for (int p = 1; p < comm->nprocs; ++p) displs[p] = displs[p - 1] + counts[p - 1];
+    all.resize(static_cast<size_t>(ntotal) * ncol);
+  }
+  MPI_Gatherv(local.data(), nsend, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE,
+              0, world);
+  local.clear();
+  return all;
+}
+
+// Gathers this step's onsets and ends to rank 0, appends them to the CSVs and
+// updates the cached counts (one reduction a step).
+void FixImpactRecorder::flush_events() {
+  const int nlocal[2] = {static_cast<int>(events_.size() / NCOL),
+                         static_cast<int>(ends_.size() / NEND)};
+  int ntotal[2] = {0, 0};
+  MPI_Allreduce(nlocal, ntotal, 2, MPI_INT, MPI_SUM, world);
+  if (ntotal[1] > 0) {
+    const std::vector<double> all = gather(ends_, NEND, ntotal[1]);
+    if (comm->me == 0) {
+      for (size_t e = 0; e + NEND <= all.size(); e += NEND) {
+        const double *r = &all[e];
+        fprintf(ends_file_, "%.9g,%.0f,%s", r[E_TIME], r[E_TAG],
+                surfaces_[static_cast<int>(r[E_SURFACE])].name.c_str());
+        for (int k = E_START; k < NEND; ++k) fprintf(ends_file_, ",%.9g", r[k]);
+        fputc('\n', ends_file_);
+      }
+      fflush(ends_file_);
+    }
+  }
+  if (ntotal[0] == 0) return;
+  const std::vector<double> all = gather(events_, NCOL, ntotal[0]);
   if (comm->me == 0) {
     for (size_t e = 0; e + NCOL <= all.size(); e += NCOL) {
       const double *r = &all[e];
@@ -472,30 +579,36 @@ double FixImpactRecorder::compute_vector(int n) {
   return n >= 0 && n < static_cast<int>(counts_.size()) ? counts_[n] : 0.0;
 }
 
-// Per-atom contact bits.
+// Per-atom contact bits and onset times (grow, copy, set, pack and unpack
+// list the same ncols_ columns in the same order).
 void FixImpactRecorder::grow_arrays(int nmax) {
-  memory->grow(state_, nmax, "impact/recorder:state");
-  for (int i = nmax_; i < nmax; ++i) state_[i] = 0.0;
+  memory->grow(state_, nmax, ncols_, "impact/recorder:state");
+  for (int i = nmax_; i < nmax; ++i) set_arrays(i);
   nmax_ = nmax;
 }
 
-void FixImpactRecorder::copy_arrays(int i, int j, int /*delflag*/) { state_[j] = state_[i]; }
+void FixImpactRecorder::copy_arrays(int i, int j, int /*delflag*/) {
+  for (int k = 0; k < ncols_; ++k) state_[j][k] = state_[i][k];
+}
 
 // A new atom starts without contacts.
-void FixImpactRecorder::set_arrays(int i) { state_[i] = 0.0; }
+void FixImpactRecorder::set_arrays(int i) {
+  state_[i][0] = 0.0;
+  for (int k = 1; k < ncols_; ++k) state_[i][k] = -1.0;
+}
 
 int FixImpactRecorder::pack_exchange(int i, double *buf) {
-  buf[0] = state_[i];
-  return 1;
+  for (int k = 0; k < ncols_; ++k) buf[k] = state_[i][k];
+  return ncols_;
 }
 
 int FixImpactRecorder::unpack_exchange(int nlocal, double *buf) {
-  state_[nlocal] = buf[0];
-  return 1;
+  for (int k = 0; k < ncols_; ++k) state_[nlocal][k] = buf[k];
+  return ncols_;
 }
 
 double FixImpactRecorder::memory_usage() {
-  double bytes = static_cast<double>(nmax_) * sizeof(double);
+  double bytes = static_cast<double>(nmax_) * ncols_ * sizeof(double);
   for (const auto &s : surfaces_) bytes += (s.tri.size() + s.normal.size()) * sizeof(double);
   return bytes;
 }

@@ -1,11 +1,14 @@
 // fix impact/recorder: records every contact onset between a particle and a
 // wall mesh (fix mesh/surface), with the velocity relative to the struck
-// surface, for LIGGGHTS 3.8. See docs/styles/fix_impact_recorder.md.
+// surface, and optionally every contact end, with the lab velocity after the
+// contact and its duration, for LIGGGHTS 3.8. See
+// docs/styles/fix_impact_recorder.md.
 //
 // Contact is decided geometrically, with the criterion fix wall/gran uses for
 // meshes: the distance from the particle centre to the nearest triangle is
 // below the radius. A per-atom bit per surface remembers "in contact" so that
-// only onsets are recorded; it travels with the atom between ranks.
+// only onsets are recorded, and the onset time per surface lets the end
+// record name its contact; both travel with the atom between ranks.
 #ifndef MILL_FIX_IMPACT_RECORDER_H
 #define MILL_FIX_IMPACT_RECORDER_H
 
@@ -65,6 +68,30 @@ class FixImpactRecorder : public Fix {
     NCOL
   };
 
+  // Columns of one contact-end record (also the contact_ends.csv columns).
+  enum EndColumn {
+    E_TIME = 0,
+    E_TAG,
+    E_SURFACE,
+    E_START,
+    E_DURATION,
+    E_X,
+    E_Y,
+    E_Z,
+    E_VX,
+    E_VY,
+    E_VZ,
+    E_SPEED,
+    E_VRX,
+    E_VRY,
+    E_VRZ,
+    E_RSPEED,
+    E_VN,
+    E_VT,
+    E_WSPEED,
+    NEND
+  };
+
  private:
   struct Surface {
     std::string name;     // label written to the CSV ("flywheel")
@@ -82,20 +109,30 @@ class FixImpactRecorder : public Fix {
   };
   std::vector<Surface> surfaces_;
   std::string file_path_;
-  FILE *file_ = nullptr;  // rank 0 only
+  FILE *file_ = nullptr;       // rank 0 only
+  std::string ends_path_;      // contact_ends CSV ("" = no end records)
+  FILE *ends_file_ = nullptr;  // rank 0 only
 
   // Cached counts (read by compute_vector): total, then one per surface.
   std::vector<double> counts_;
 
+  // Per atom: column 0 holds bit s set while in contact with surface s;
+  // column 1 + s the onset time of that contact (-1: no onset recorded, e.g.
+  // already touching when the run started).
   int nmax_ = 0;
-  double *state_ = nullptr;     // per atom: bit s set while in contact with surface s
+  int ncols_ = 1;
+  double **state_ = nullptr;
   std::vector<double> events_;  // this step's onsets on this rank, NCOL per event
+  std::vector<double> ends_;    // this step's contact ends on this rank, NEND per event
 
   void parse_args(int narg, char **arg);
   void load_triangles(Surface &s);
   void set_bound(Surface &s);
   bool nearest_point(Surface &s, const double *x, double radius, double *c);
+  void surface_velocity(const Surface &s, const double *c, double *w, double *raxis) const;
   void record(const Surface &s, int is, int i, const double *c);
+  void record_end(Surface &s, int is, int i, double start);
+  std::vector<double> gather(std::vector<double> &local, int ncol, int ntotal);
   void flush_events();
 };
 

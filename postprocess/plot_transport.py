@@ -6,6 +6,15 @@ flywheel_impact_speed.png   histogram of impact speed relative to the beater sur
 flywheel_normal_speed.png   histogram of its normal part
 flywheel_angle.png          histogram of the impact angle (90 deg = normal)
 collisions_per_particle.png histogram of impacts per lump (flywheel, all surfaces)
+flywheel_first_strike_speed.png  first strike of each lump against later strikes (relative speed)
+flywheel_rebound_speed_lab.png   lab speed of the lumps leaving the beaters (contact ends)
+strike_to_housing_speed.png      lab speed at the next housing impact after a strike
+strike_to_housing_angle.png      its angle to the wall
+strike_to_housing_flight_time.png  time from leaving the beater to that housing impact
+impacts_per_part.png        impacts (not sliding) per struck part, and sliding contacts
+
+Sliding contacts (normal speed below transport.sliding_threshold) are left
+out of every impact histogram.
 
 Usage: plot_transport.py --h5 transport/rpm2000/transport.h5 --out transport/rpm2000/plots
 """
@@ -85,6 +94,16 @@ def trajectories(f, geo, out, max_lumps=40, span=0.3):
     plt.close(fig)
 
 
+def finish(fig, ax, xlabel, title, path):
+    """Labels a histogram's axes and title and saves it."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("count")
+    ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
 def histogram(values, xlabel, title, path, bins=30, discrete=False):
     """One histogram PNG; says so when there is nothing to plot."""
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -98,11 +117,80 @@ def histogram(values, xlabel, title, path, bins=30, discrete=False):
         ax.legend()
     else:
         ax.text(0.5, 0.5, "no impacts", ha="center", va="center", transform=ax.transAxes)
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel("count")
-    ax.set_title(title, fontsize=10)
+    finish(fig, ax, xlabel, title, path)
+
+
+def overlaid(groups, xlabel, title, path, bins=30):
+    """Histograms of several labelled lists on common bins (label, values, colour)."""
+    fig, ax = plt.subplots(figsize=(6, 4))
+    allv = np.concatenate([np.asarray(v, dtype=float) for _, v, _ in groups]) if groups else np.zeros(0)
+    if len(allv):
+        edges = np.histogram_bin_edges(allv, bins=bins)
+        for label, v, col in groups:
+            if len(v):
+                ax.hist(v, bins=edges, color=col, alpha=0.6, edgecolor="k",
+                        label="%s: %d, mean %.3g" % (label, len(v), np.mean(v)))
+        ax.legend(fontsize=8)
+    else:
+        ax.text(0.5, 0.5, "no strikes", ha="center", va="center", transform=ax.transAxes)
+    finish(fig, ax, xlabel, title, path)
+
+
+def finite(a):
+    a = np.asarray(a, dtype=float)
+    return a[np.isfinite(a)]
+
+
+def strikes(f, rpm, out):
+    """The beater strikes (/strikes) and the housing impacts after them."""
+    if "strikes" not in f:
+        return
+    s = f["strikes"]
+    first = s["first"][...] == 1
+    speed = s["impact_speed"][...]
+    overlaid([("first strike of a lump", speed[first], "tab:orange"), ("later strikes", speed[~first], "tab:blue")],
+             "impact speed relative to the beater (m/s)",
+             "Beater strikes at %g rpm: first strike of each lump and later ones" % rpm,
+             os.path.join(out, "flywheel_first_strike_speed.png"))
+    histogram(finite(s["rebound_speed_lab"][...]), "lab speed leaving the beater (m/s)",
+              "Lumps leaving the beaters at %g rpm (lab frame, at the end of the contact)" % rpm,
+              os.path.join(out, "flywheel_rebound_speed_lab.png"))
+    histogram(finite(s["housing_speed"][...]), "lab speed at the housing (m/s)",
+              "Next housing impact after a beater strike, %g rpm" % rpm,
+              os.path.join(out, "strike_to_housing_speed.png"))
+    histogram(finite(s["housing_angle"][...]), "impact angle to the wall (deg, 90 = normal)",
+              "Next housing impact after a strike: angle, %g rpm" % rpm,
+              os.path.join(out, "strike_to_housing_angle.png"), bins=18)
+    histogram(1e3 * finite(s["flight_time"][...]), "time of flight from the beater to the housing (ms)",
+              "Flight from the beater to the housing, %g rpm" % rpm,
+              os.path.join(out, "strike_to_housing_flight_time.png"))
+
+
+def parts(f, rpm, out):
+    """Impacts (not sliding) per struck part, and the sliding contacts."""
+    imp = f["impacts"]
+    if "part" not in imp:
+        return
+    codes = imp.attrs["part_codes"]
+    codes = codes.decode() if isinstance(codes, bytes) else str(codes)
+    names = [c.split(" = ")[1] for c in codes.split(", ")[1:]]
+    part = imp["part"][...]
+    sliding = imp["sliding"][...] == 1
+    counts = [int(np.sum((part == k) & ~sliding)) for k in range(len(names))]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    labels = names + ["sliding (all parts)"]
+    values = counts + [int(np.sum(sliding))]
+    flywheel = ("plate_face", "plate_tip", "hub", "side_cap")
+    colours = ["tab:orange" if n in flywheel else "0.8" if n == "other" else "tab:blue" for n in names] + ["0.6"]
+    ax.bar(range(len(values)), values, color=colours, edgecolor="k")
+    for k, v in enumerate(values):
+        ax.text(k, v, str(v), ha="center", va="bottom", fontsize=8)
+    ax.set_xticks(range(len(values)))
+    ax.set_xticklabels(labels, rotation=35, ha="right", fontsize=8)
+    ax.set_ylabel("contacts")
+    ax.set_title("Impacts per struck part at %g rpm (orange: flywheel, blue: housing)" % rpm, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
+    fig.savefig(os.path.join(out, "impacts_per_part.png"), dpi=130)
     plt.close(fig)
 
 
@@ -117,6 +205,8 @@ def main():
         rpm = f.attrs["rpm"]
         imp = f["impacts"]
         fly = imp["surface"][...] == 0
+        if "sliding" in imp:
+            fly &= imp["sliding"][...] == 0
         trajectories(f, geo, a.out)
         tag = "flywheel at %g rpm, relative to the beater surface" % rpm
         histogram(imp["speed"][...][fly], "impact speed (m/s)", "Impact speed, " + tag,
@@ -142,6 +232,8 @@ def main():
         fig.tight_layout()
         fig.savefig(os.path.join(a.out, "collisions_per_particle.png"), dpi=130)
         plt.close(fig)
+        strikes(f, rpm, a.out)
+        parts(f, rpm, a.out)
 
 
 if __name__ == "__main__":

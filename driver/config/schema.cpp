@@ -138,7 +138,7 @@ Schema make_case_schema() {
       at_least(key("flow.max_iterations", T::Int, "", "600", "Iteration cap of the steady solver"), 1),
       positive(key("flow.residual_target", T::Real, "", "1e-4", "Initial-residual target for p and U (convergence)")),
       key("flow.allow_unconverged", T::Bool, "", "false",
-          "Go on with a flow that missed flow.residual_target within flow.max_iterations (sample, transport and what follows run on it; the report says so at the top). false: the sample stage stops with an error naming the run"),
+          "Go on with a flow that missed flow.residual_target within flow.max_iterations (sample, transport and what follows run on it; the report says so at the top). false: the sample and transport stages stop with an error naming the run"),
       choice("flow.domain", "half", {"half", "full"},
              "half: solve z >= 0 with a symmetry plane at z = 0 and mirror it (the mill is mirror-symmetric; the full-domain steady solve is carried away by an antisymmetric mode, see docs/flow.md); full: the whole housing"),
 
@@ -155,6 +155,8 @@ Schema make_case_schema() {
       at_least(key("injection.seed", T::Int, "", "4711", "Random seed of the insertion"), 1),
       positive(key("transport.trajectory_interval", T::Real, "s", "2e-3", "Trajectory sampling interval (transport.h5, plot)")),
       at_least(key("transport.vtk_interval", T::Real, "s", "0.01", "VTK dump interval of lumps and meshes (ParaView); 0 = none"), 0),
+      positive(key("transport.sliding_threshold", T::Real, "m/s", "1.0",
+                   "Contacts whose normal speed relative to the surface is below this are sliding (touch-downs, rolling, chatter): counted apart (summary.json sliding_contacts), left out of the impact statistics and of the beater strikes")),
 
       // --- ore ---
       key("ore.card", T::Path, "", "liggghts_inputs/materials/sandstone.yaml",

@@ -116,7 +116,18 @@ json headline_json(const fs::path& run, Problems* problems) {
                            {"flywheel_impact_speed_mean_m_s", pick(t, "flywheel_impact_speed_mean_m_s")},
                            {"flywheel_impact_speed_std_m_s", pick(t, "flywheel_impact_speed_std_m_s")},
                            {"flywheel_normal_speed_mean_m_s", pick(t, "flywheel_normal_speed_mean_m_s")},
-                           {"flywheel_angle_mean_deg", pick(t, "flywheel_angle_mean_deg")}};
+                           {"flywheel_angle_mean_deg", pick(t, "flywheel_angle_mean_deg")},
+                           {"flywheel_first_strike_speed_mean_m_s", pick(t, "flywheel_first_strike_speed_mean_m_s")},
+                           {"flywheel_rebound_speed_lab_mean_m_s", pick(t, "flywheel_rebound_speed_lab_mean_m_s")},
+                           {"flywheel_rebound_speed_lab_std_m_s", pick(t, "flywheel_rebound_speed_lab_std_m_s")},
+                           {"strike_to_housing_speed_mean_m_s", pick(t, "strike_to_housing_speed_mean_m_s")},
+                           {"strike_to_housing_speed_std_m_s", pick(t, "strike_to_housing_speed_std_m_s")},
+                           {"strike_to_housing_angle_mean_deg", pick(t, "strike_to_housing_angle_mean_deg")},
+                           {"strike_to_housing_flight_time_mean_s", pick(t, "strike_to_housing_flight_time_mean_s")},
+                           {"n_strike_to_housing", pick(t, "n_strike_to_housing")},
+                           {"sliding_contacts", pick(t, "sliding_contacts")},
+                           {"sliding_threshold_m_s", pick(t, "sliding_threshold_m_s")},
+                           {"flow_converged", pick(t, "flow_converged")}};
   }
   const auto cal = read_json(run / "calibrate" / "report.json", problems);
   if (!cal.is_null())
@@ -238,7 +249,37 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
                           : "",
                       num(pick(t, "flywheel_angle_mean_deg"))
                           ? fmt::format(", {:.0f} deg to the surface", d(t.at("flywheel_angle_mean_deg")))
+                          : "") +
+              (num(pick(t, "flywheel_first_strike_speed_mean_m_s"))
+                   ? fmt::format("; first strike of a lump {} m/s", speed(d(t.at("flywheel_first_strike_speed_mean_m_s"))))
+                   : ""));
+    if (num(pick(t, "flywheel_rebound_speed_lab_mean_m_s")))
+      add(1, "speed of the lumps leaving the beaters (lab frame)" + at,
+          fmt::format("{} m/s{}", speed(d(t.at("flywheel_rebound_speed_lab_mean_m_s"))),
+                      num(pick(t, "flywheel_rebound_speed_lab_std_m_s"))
+                          ? fmt::format(" ± {} (sd)", speed(d(t.at("flywheel_rebound_speed_lab_std_m_s"))))
                           : ""));
+    if (num(pick(t, "strike_to_housing_speed_mean_m_s")) && num(pick(t, "n_strike_to_housing")) &&
+        t.at("n_strike_to_housing").get<long>() > 0)
+      add(1, "housing impact after a beater strike" + at,
+          fmt::format("{} m/s{}{}{}", speed(d(t.at("strike_to_housing_speed_mean_m_s"))),
+                      num(pick(t, "strike_to_housing_speed_std_m_s"))
+                          ? fmt::format(" ± {} (sd)", speed(d(t.at("strike_to_housing_speed_std_m_s"))))
+                          : "",
+                      num(pick(t, "strike_to_housing_angle_mean_deg"))
+                          ? fmt::format(", {:.0f} deg to the wall", d(t.at("strike_to_housing_angle_mean_deg")))
+                          : "",
+                      num(pick(t, "strike_to_housing_flight_time_mean_s"))
+                          ? fmt::format(", {} ms after leaving the beater",
+                                        g3(1e3 * d(t.at("strike_to_housing_flight_time_mean_s"))))
+                          : ""));
+    if (num(pick(t, "sliding_contacts")))
+      add(1, "sliding contacts (left out of the impact figures)" + at,
+          fmt::format("{}{}", t.at("sliding_contacts").get<long>(),
+                      num(pick(t, "sliding_threshold_m_s"))
+                          ? fmt::format(" below {:g} m/s normal speed", d(t.at("sliding_threshold_m_s")))
+                          : ""),
+          false);
   }
 
   const json cal = pick(h, "calibration");

@@ -174,6 +174,12 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
           !it->at("converged").get<bool>())
         unconverged.push_back(it.key());
     }
+  // The transport stage records the flow state of the field it ran on.
+  if (head.contains("transport") && head["transport"].is_object())
+    for (auto it = head["transport"].begin(); it != head["transport"].end(); ++it)
+      if (it->is_object() && it->contains("flow_converged") && it->at("flow_converged") == false &&
+          std::find(unconverged.begin(), unconverged.end(), it.key()) == unconverged.end())
+        unconverged.push_back(it.key());
   if (!unconverged.empty()) {
     std::string list;
     for (const auto& r : unconverged) list += (list.empty() ? "" : ", ") + r;

@@ -26,7 +26,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;
-constexpr int kDeckVersion = 4;  // 4: fluid/drag checks the field's rotor speed (omega)
+constexpr int kDeckVersion = 5;  // 5: impact/recorder writes contact ends (contact_ends.csv)
 
 // One lump of the injection schedule.
 struct Lump {
@@ -183,11 +183,65 @@ std::array<double, 4> read_end(const fs::path& f) {
   return v;
 }
 
+// Whether the flow behind the sampled field converged (sample_report.json's
+// flow_converged; null when the sample stage wrote no report). An unconverged
+// flow stops the stage unless flow.allow_unconverged, as in the sample stage.
+nlohmann::json check_flow_converged(const StageContext& ctx, const std::string& label) {
+  const fs::path rep_file = ctx.run_dir / "sample" / label / "sample_report.json";
+  if (!fs::exists(rep_file)) return nullptr;
+  std::ifstream in(rep_file);
+  const auto rep = nlohmann::json::parse(in, nullptr, false);
+  if (!rep.is_object() || !rep.contains("flow_converged") || !rep["flow_converged"].is_boolean())
+    return nullptr;
+  const bool converged = rep["flow_converged"].get<bool>();
+  if (!converged && !ctx.cfg.doc.boolean("flow.allow_unconverged"))
+    throw std::runtime_error(fmt::format(
+        "sample/{} holds the gas field of flow/{}, which did not converge (flow_converged: false "
+        "in {}); its gas field is not a prediction. Raise flow.max_iterations or choose another "
+        "flow.mesh_preset and rerun --stage flow and --stage sample, or set "
+        "flow.allow_unconverged: true in {} to go on with it (the report then says so at the top)",
+        label, label, rep_file.string(), ctx.cfg.doc.file()));
+  return converged;
+}
+
 // JSON of one MeanStd-valued statistic pair.
 void put(nlohmann::json& j, const std::string& prefix, const post::MeanStd& m,
          const std::string& unit) {
   j[prefix + "_mean_" + unit] = m.mean;
   j[prefix + "_std_" + unit] = m.std;
+}
+
+// summary.json keys of the sliding contacts, the struck parts, the beater
+// strikes and the housing impacts that follow them.
+void strike_keys(nlohmann::json& j, const post::TransportStats& st, double sliding_threshold) {
+  const post::StrikeStats& k = st.strikes;
+  j["sliding_threshold_m_s"] = sliding_threshold;
+  j["sliding_contacts"] = st.sliding_contacts;
+  j["sliding_contacts_flywheel"] = st.sliding.at("flywheel");
+  j["sliding_contacts_housing"] = st.sliding.at("housing");
+  nlohmann::json parts = nlohmann::json::object();
+  for (const auto& p : post::PartNames()) {
+    const auto it = st.impacts_per_part.find(p);
+    parts[p] = it == st.impacts_per_part.end() ? 0LL : it->second;
+  }
+  j["impacts_per_part"] = parts;
+  j["n_flywheel_first_strikes"] = k.n_first;
+  j["n_flywheel_later_strikes"] = k.n_later;
+  put(j, "flywheel_first_strike_speed", k.first_speed, "m_s");
+  put(j, "flywheel_later_strike_speed", k.later_speed, "m_s");
+  j["n_flywheel_strikes_with_contact_end"] = k.n_with_end;
+  put(j, "flywheel_rebound_speed_lab", k.rebound_speed_lab, "m_s");
+  put(j, "flywheel_rebound_normal_speed", k.rebound_normal_speed, "m_s");
+  put(j, "flywheel_contact_duration", k.contact_duration, "s");
+  j["n_strike_to_housing"] = k.n_to_housing;
+  put(j, "strike_to_housing_speed", k.housing_speed, "m_s");
+  put(j, "strike_to_housing_angle", k.housing_angle, "deg");
+  put(j, "strike_to_housing_flight_time", k.flight_time, "s");
+  j["strike_note"] =
+      "a strike is a flywheel impact at or above the sliding threshold (normal speed); the "
+      "rebound is the lab speed at the end of its contact; strike_to_housing: the lump's next "
+      "housing impact after it left the beater and before its next strike (lab speed, angle to "
+      "the wall, time since the contact ended)";
 }
 
 }  // namespace
@@ -209,15 +263,18 @@ Plan TransportStage::plan(const StageContext& ctx) const {
   return p;
 }
 
-// transport/<label>/{impacts.csv, transport.h5, summary.json}: exist and read.
+// transport/<label>/{impacts.csv, contact_ends.csv, transport.h5, summary.json}:
+// exist and read.
 std::string TransportStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
   const fs::path out = ctx.stage_dir / job.label;
-  if (auto r = jobs::first_problem({jobs::check_json(out / "summary.json"), jobs::check_hdf5(out / "transport.h5"),
-                                    jobs::check_file(out / "impacts.csv")});
+  if (auto r = jobs::first_problem(
+          {jobs::check_json(out / "summary.json"), jobs::check_hdf5(out / "transport.h5"),
+           jobs::check_file(out / "impacts.csv"), jobs::check_file(out / "contact_ends.csv")});
       !r.empty())
     return r;
   try {
     post::ReadImpactsCsv((out / "impacts.csv").string());
+    post::ReadContactEndsCsv((out / "contact_ends.csv").string());
   } catch (const std::exception& e) {
     return e.what();
   }
@@ -236,6 +293,7 @@ void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pa
         "stage transport ({}) needs {} (the sampled gas field at {:g} rpm); make it with "
         "`orchestrate --case {} --stage sample --output {}` (after --stage flow)",
         label, field_file.string(), rpm, d.file(), ctx.run_dir.string()));
+  const nlohmann::json flow_converged = check_flow_converged(ctx, label);
   // injection.time_limit > duration and the time step: checked with the case.
   const double duration = d.real("injection.duration"), t_limit = d.real("injection.time_limit");
   const geometry::MillGeometry g = geometry::MillGeometry::from_config(d);
@@ -295,9 +353,20 @@ void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pa
   // Statistics.
   std::vector<double> insert_time;
   for (const auto& l : lumps) insert_time.push_back(l.t);
-  const auto records = post::ReadImpactsCsv((work / "impacts.csv").string());
+  auto records = post::ReadImpactsCsv((work / "impacts.csv").string());
+  const auto ends = post::ReadContactEndsCsv((work / "contact_ends.csv").string());
   const auto traj = post::ReadTrajectoryDump((work / "traj.dump").string(), dt);
-  const post::TransportStats st = post::ComputeTransportStats(records, insert_time);
+  post::MillShape shape;
+  shape.height = g.height;
+  shape.width = g.width;
+  shape.depth = g.depth;
+  shape.axis_x = g.axis_x;
+  shape.axis_y = g.axis_height;
+  shape.hub_radius = g.hub_radius();
+  shape.tip_radius = g.tip_radius();
+  const double sliding_threshold = d.real("transport.sliding_threshold");
+  post::LabelImpacts(records, shape, sliding_threshold);
+  const post::TransportStats st = post::ComputeTransportStats(records, insert_time, ends);
   const post::SurfaceStats& fly = st.surfaces.at("flywheel");
   const post::SurfaceStats& wall = st.surfaces.at("housing");
 
@@ -330,6 +399,9 @@ void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pa
   put(j, "wall_impact_speed", wall.speed, "m_s");
   put(j, "wall_normal_speed", wall.normal_speed, "m_s");
   put(j, "wall_angle", wall.angle, "deg");
+  strike_keys(j, st, sliding_threshold);
+  j["flow_converged"] = flow_converged;
+  j["flow_allow_unconverged"] = d.boolean("flow.allow_unconverged");
   long long gentle_fly = 0,
             gentle_wall = 0;  // touch-downs, rolling and chatter rather than impacts
   for (const auto& r : records)
@@ -349,7 +421,7 @@ void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pa
   j["flywheel_impacts_per_particle_mean"] = st.flywheel_impacts_per_particle_mean;
   j["first_impact_time_mean_s"] = st.first_impact_time_mean_s;
   j["first_impact_time_note"] =
-      "time from insertion to the first impact (any surface), over particles with one";
+      "time from insertion to the first impact (any surface; sliding contacts are not impacts), over particles with one";
   j["particles_with_impact"] = st.particles_with_impact;
   j["cross_check"] = {{"rim_speed_m_s", omega * g.tip_radius()},
                       {"inlet_velocity_down_mean_m_s", v_in},
@@ -390,13 +462,16 @@ void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pa
   // Outputs: transport/<label>/, each file complete or absent.
   const fs::path out = ctx.stage_dir / label;
   fs::create_directories(out);
-  for (const char* f : {"summary.json", "impacts.csv", "transport.h5"}) fs::remove(out / f);
-  post::WriteTransportH5((out / "transport.h5").string(), records, st, insert_time, traj, meta);
+  for (const char* f : {"summary.json", "impacts.csv", "contact_ends.csv", "transport.h5"})
+    fs::remove(out / f);
+  post::WriteTransportH5((out / "transport.h5").string(), records, st, insert_time, traj, meta,
+                         ends);
+  post::WriteImpactsCsv((out / "impacts.csv").string(), records);
   {
-    std::ifstream in(work / "impacts.csv");
+    std::ifstream in(work / "contact_ends.csv");
     std::stringstream ss;
     ss << in.rdbuf();
-    jobs::atomic_write(out / "impacts.csv", ss.str());
+    jobs::atomic_write(out / "contact_ends.csv", ss.str());
   }
   engine::Command c;
   c.argv = {"/usr/bin/python3",
@@ -414,18 +489,27 @@ void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pa
   ctx.progress.info(fmt::format(
       "[transport] {}: {} lumps, {} exited, {} flywheel impacts ({:.2f} per lump): speed {:.1f} +- "
       "{:.1f} m/s, "
-      "normal {:.1f} m/s, angle {:.1f} deg; {} wall impacts; first impact after {:.3f} s [{:.1f} "
-      "s]",
+      "normal {:.1f} m/s, angle {:.1f} deg; {} wall impacts; {} sliding contacts (below {:g} m/s "
+      "normal); first impact after {:.3f} s [{:.1f} s]",
       label, st.n_particles, std::llround(end[2]), fly.n, st.flywheel_impacts_per_particle_mean,
       fly.speed.mean, fly.speed.std, fly.normal_speed.mean, fly.angle.mean, wall.n,
-      st.first_impact_time_mean_s, res.seconds));
+      st.sliding_contacts, sliding_threshold, st.first_impact_time_mean_s, res.seconds));
+  ctx.progress.info(fmt::format(
+      "[transport] {}: {} first and {} later beater strikes (first {:.1f} m/s); lumps leave the "
+      "beaters at {:.1f} +- {:.1f} m/s (lab); {} strikes reach the housing next, at {:.1f} +- "
+      "{:.1f} m/s, {:.0f} deg, after {:.1f} ms",
+      label, st.strikes.n_first, st.strikes.n_later, st.strikes.first_speed.mean,
+      st.strikes.rebound_speed_lab.mean, st.strikes.rebound_speed_lab.std, st.strikes.n_to_housing,
+      st.strikes.housing_speed.mean, st.strikes.housing_speed.std, st.strikes.housing_angle.mean,
+      1e3 * st.strikes.flight_time.mean));
   ctx.progress.info(fmt::format(
       "[transport] {}: cross-check: rim speed {:.1f} m/s; ballistic estimate {:.1f} m/s (approach "
       "{:.1f} m/s, "
       "rotor {:.1f} m/s at r = {:.3f} m) vs simulated mean {:.1f} m/s",
       label, omega * g.tip_radius(), v_ballistic, v_approach, v_rotor, r_struck, fly.speed.mean));
   ctx.progress.info(fmt::format(
-      "[transport] results: {}/{{impacts.csv, transport.h5, summary.json, plots/*.png}}",
+      "[transport] results: {}/{{impacts.csv, contact_ends.csv, transport.h5, summary.json, "
+      "plots/*.png}}",
       out.string()));
 }
 

@@ -1,7 +1,8 @@
 // Stage 'transport': ore lumps through the mill in the sampled gas flow
 // (LIGGGHTS, one-way coupled), one job per rotor speed. Each job writes
-// transport/<rpm label>/{impacts.csv, transport.h5, summary.json, plots/*.png}
-// and keeps its LIGGGHTS run (VTK dumps, log) in transport/jobs/<label>/run.
+// transport/<rpm label>/{impacts.csv, contact_ends.csv, transport.h5,
+// summary.json, plots/*.png} and keeps its LIGGGHTS run (VTK dumps, log) in
+// transport/jobs/<label>/run.
 #pragma once
 
 #include "stages/stage.h"

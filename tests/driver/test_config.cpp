@@ -57,6 +57,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_not_yaml.yaml", {"bad_not_yaml.yaml:", "not valid YAML"}},
         BadCase{"bad_edges_order.yaml", {":3:", "breakage.size_fraction_edges", "ascending", "0.1 after 0.2"}},
         BadCase{"bad_bool.yaml", {":3:", "sample.turbulence", "'maybe'", "true or false"}},
+        BadCase{"bad_sliding_threshold.yaml", {":3:", "transport.sliding_threshold", "0", "> 0 m/s"}},
         BadCase{"bad_int_float.yaml", {":3:", "injection.n_lumps", "'36.5'", "integer"}},
         BadCase{"bad_flywheel_too_tall.yaml", {":4:", "mill.flywheel.axis_height", "0.3", "must fit"}},
         BadCase{"bad_ore_ucs.yaml", {"bad_ore_ucs_card.yaml:5:", "ucs", "tensile_strength"}},

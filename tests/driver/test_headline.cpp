@@ -97,4 +97,30 @@ TEST(Headline, NoJkFitSaysWhy) {
   EXPECT_EQ(value_of(rows, "JK breakage parameters"), "not fitted: t10 not resolved at any impact");
 }
 
+// The transport's beater strikes: the lab speed leaving the beaters and the
+// housing impact that follows, from summary.json through headline_json.
+TEST(Headline, LumpsLeavingTheBeatersAndTheirNextHousingImpact) {
+  namespace fs = std::filesystem;
+  const fs::path run = fs::temp_directory_path() / ("mill_headline_tr_" + std::to_string(getpid()));
+  fs::remove_all(run);
+  fs::create_directories(run / "transport/rpm2000");
+  std::ofstream(run / "transport/rpm2000/summary.json")
+      << R"({"n_particles": 360, "n_flywheel_impacts": 512, "n_wall_impacts": 2011,
+            "flywheel_impact_speed_mean_m_s": 71.4, "flywheel_impact_speed_std_m_s": 18.2,
+            "flywheel_first_strike_speed_mean_m_s": 98.6,
+            "flywheel_rebound_speed_lab_mean_m_s": 131.7, "flywheel_rebound_speed_lab_std_m_s": 24.9,
+            "strike_to_housing_speed_mean_m_s": 112.3, "strike_to_housing_speed_std_m_s": 30.1,
+            "strike_to_housing_angle_mean_deg": 41.6, "strike_to_housing_flight_time_mean_s": 0.0123,
+            "n_strike_to_housing": 402, "sliding_contacts": 1403, "sliding_threshold_m_s": 1.0,
+            "flow_converged": true})";
+  const auto rows = headline_rows(mill::report::headline_json(run));
+  EXPECT_EQ(value_of(rows, "flywheel impact speed, 2000 rpm"), "71 m/s ± 18 (sd); first strike of a lump 99 m/s");
+  EXPECT_EQ(value_of(rows, "speed of the lumps leaving the beaters (lab frame), 2000 rpm"), "132 m/s ± 25 (sd)");
+  EXPECT_EQ(value_of(rows, "housing impact after a beater strike, 2000 rpm"),
+            "112 m/s ± 30 (sd), 42 deg to the wall, 12.3 ms after leaving the beater");
+  EXPECT_EQ(value_of(rows, "sliding contacts (left out of the impact figures), 2000 rpm"),
+            "1403 below 1 m/s normal speed");
+  fs::remove_all(run);
+}
+
 }  // namespace

@@ -1,19 +1,23 @@
 // The transport stage end to end with real LIGGGHTS runs, on a synthetic gas
 // field (solid-body rotation plus a downdraft inside a small housing) written
-// with write_flow_field where the sample stage would put it.
+// with write_flow_field where the sample stage would put it, beside a
+// sample_report.json that says the flow behind it did not converge (as the
+// tiny flow's 30 iterations do not): the stage stops unless the case sets
+// flow.allow_unconverged, and records the override.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 
+#include "e2e_util.h"
 #include "postprocess/flow_field_io.h"
 #include "postprocess/impact_stats.h"
-
-#include "e2e_util.h"
 
 namespace fs = std::filesystem;
 
@@ -36,6 +40,14 @@ transport: {trajectory_interval: 2.0e-3, vtk_interval: 0.05}
 ore: {card: sandstone}
 resources: {np: 1, jobs: 1}
 )";
+
+// What the sample stage writes beside the field of an unconverged flow (the
+// keys the transport stage reads).
+void write_unconverged_sample_report(const fs::path& file) {
+  fs::create_directories(file.parent_path());
+  std::ofstream(file) << R"({"rpm": 2000, "flow_converged": false, "flow_domain": "half"})"
+                      << "\n";
+}
 
 // Solid-body rotation at a tenth of the rotor speed about the rotor axis plus
 // a 2 m/s downdraft, inside the housing; no gas inside the hub.
@@ -72,8 +84,9 @@ class TinyTransport : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new fs::path(scratch("transport"));
-    std::ofstream(*dir_ / "case.yaml") << kCase;
+    std::ofstream(*dir_ / "case.yaml") << kCase << "flow: {allow_unconverged: true}\n";
     write_synthetic_field(*dir_ / "run" / "sample" / "rpm2000" / "field.h5");
+    write_unconverged_sample_report(*dir_ / "run" / "sample" / "rpm2000" / "sample_report.json");
     status_ = orchestrate("--case " + (*dir_ / "case.yaml").string() +
                               " --stage transport --output " + (*dir_ / "run").string(),
                           *dir_ / "transport.log");
@@ -88,9 +101,13 @@ int TinyTransport::status_ = -1;
 TEST_F(TinyTransport, RunsAndWritesEveryOutput) {
   ASSERT_EQ(status_, 0) << slurp(*dir_ / "transport.log");
   const fs::path out = *dir_ / "run" / "transport" / "rpm2000";
-  for (const char* f : {"impacts.csv", "transport.h5", "summary.json", "plots/trajectories.png",
-                        "plots/flywheel_impact_speed.png", "plots/flywheel_normal_speed.png",
-                        "plots/flywheel_angle.png", "plots/collisions_per_particle.png"})
+  for (const char* f :
+       {"impacts.csv", "contact_ends.csv", "transport.h5", "summary.json", "plots/trajectories.png",
+        "plots/flywheel_impact_speed.png", "plots/flywheel_normal_speed.png",
+        "plots/flywheel_angle.png", "plots/collisions_per_particle.png",
+        "plots/flywheel_first_strike_speed.png", "plots/flywheel_rebound_speed_lab.png",
+        "plots/strike_to_housing_speed.png", "plots/strike_to_housing_angle.png",
+        "plots/strike_to_housing_flight_time.png", "plots/impacts_per_part.png"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   EXPECT_EQ(mill::post::dataset_unit(out / "transport.h5", "impacts/speed"), "m/s");
   EXPECT_EQ(mill::post::dataset_unit(out / "transport.h5", "impacts/angle"), "deg");
@@ -113,15 +130,68 @@ TEST_F(TinyTransport, ImpactStatisticsArePlausible) {
   const double v = j.at("flywheel_impact_speed_mean_m_s").get<double>();
   EXPECT_GT(v, 0.2 * rim);
   EXPECT_LT(v, 1.5 * rim);
+  // Sliding contacts are counted apart from the impacts; every record names its part.
   const auto rec = mill::post::ReadImpactsCsv((out / "impacts.csv").string());
-  long n = 0;
-  for (const auto& r : rec) n += r.surface == "flywheel";
+  long n = 0, sliding = 0, first = 0, later = 0;
+  std::map<std::string, long> parts;
+  for (const auto& r : rec) {
+    EXPECT_NE(r.part, "") << r.time_s;
+    EXPECT_NE(r.part, "other") << r.time_s;
+    EXPECT_EQ(r.sliding, r.normal_speed_m_s < 1.0) << r.time_s;
+    sliding += r.sliding;
+    if (r.sliding) continue;
+    ++parts[r.part];
+    n += r.surface == "flywheel";
+    first += r.strike == 1;
+    later += r.strike == 2;
+  }
   EXPECT_EQ(n, nfly);
-  EXPECT_EQ(static_cast<long>(rec.size()), nfly + j.at("n_wall_impacts").get<long>());
+  EXPECT_EQ(sliding, j.at("sliding_contacts").get<long>());
+  EXPECT_EQ(static_cast<long>(rec.size()), nfly + j.at("n_wall_impacts").get<long>() + sliding);
+  EXPECT_EQ(first, j.at("n_flywheel_first_strikes").get<long>());
+  EXPECT_EQ(later, j.at("n_flywheel_later_strikes").get<long>());
+  EXPECT_LE(first, 6);
+  EXPECT_EQ(first + later, nfly);
+  for (const auto& [p, c] : parts) EXPECT_EQ(j.at("impacts_per_part").at(p).get<long>(), c) << p;
+  // Lumps leave the beaters at up to about twice the rim speed (lab frame).
+  const double lab = j.at("flywheel_rebound_speed_lab_mean_m_s").get<double>();
+  EXPECT_GT(j.at("n_flywheel_strikes_with_contact_end").get<long>(), 0);
+  EXPECT_GT(lab, 0.2 * rim);
+  EXPECT_LT(lab, 2.5 * rim);
+  const auto ends = mill::post::ReadContactEndsCsv((out / "contact_ends.csv").string());
+  EXPECT_GE(ends.size(),
+            static_cast<size_t>(j.at("n_flywheel_strikes_with_contact_end").get<long>()));
   for (const char* k :
        {"flywheel_impact_speed_std_m_s", "flywheel_normal_speed_mean_m_s",
-        "flywheel_angle_mean_deg", "impacts_per_particle_mean", "first_impact_time_mean_s"})
+        "flywheel_angle_mean_deg", "impacts_per_particle_mean", "first_impact_time_mean_s",
+        "flywheel_first_strike_speed_mean_m_s", "flywheel_rebound_speed_lab_std_m_s",
+        "strike_to_housing_speed_mean_m_s", "strike_to_housing_speed_std_m_s",
+        "strike_to_housing_angle_mean_deg", "strike_to_housing_flight_time_mean_s",
+        "n_strike_to_housing", "sliding_threshold_m_s", "n_flywheel_contacts_below_1m_s"})
     EXPECT_TRUE(j.contains(k)) << k;
+  std::printf(
+      "tiny transport: %ld flywheel impacts (%ld first strikes), %ld sliding; lab rebound %.1f "
+      "m/s; %ld strikes reach the housing at %.1f m/s after %.2f ms\n",
+      nfly, first, sliding, lab, j.at("n_strike_to_housing").get<long>(),
+      j.at("strike_to_housing_speed_mean_m_s").get<double>(),
+      1e3 * j.at("strike_to_housing_flight_time_mean_s").get<double>());
+}
+
+// The run went on with an unconverged flow because the case said so: the
+// summary records it, and the report says so at the top.
+TEST_F(TinyTransport, UnconvergedFlowOverrideIsRecorded) {
+  ASSERT_EQ(status_, 0);
+  const auto j =
+      nlohmann::json::parse(slurp(*dir_ / "run" / "transport" / "rpm2000" / "summary.json"));
+  EXPECT_EQ(j.at("flow_converged"), false);
+  EXPECT_EQ(j.at("flow_allow_unconverged"), true);
+  const int st = orchestrate("--case " + (*dir_ / "case.yaml").string() +
+                                 " --stage report --output " + (*dir_ / "run").string(),
+                             *dir_ / "report.log");
+  ASSERT_EQ(st, 0) << slurp(*dir_ / "report.log");
+  const std::string page = slurp(*dir_ / "run" / "report" / "index.html");
+  EXPECT_NE(page.find("The gas flow did not converge"), std::string::npos);
+  EXPECT_NE(page.find("speed of the lumps leaving the beaters"), std::string::npos);
 }
 
 // Without the sample stage's field the stage fails and names the file and the command.
@@ -140,6 +210,24 @@ TEST(TransportMissingField, NamesFileAndCommand) {
 }  // namespace
 
 namespace {
+
+// A field sampled from an unconverged flow stops the stage when the case does
+// not allow it, with a message that names the run, the key and what to do.
+TEST(TransportUnconvergedFlow, StopsWithTheMessage) {
+  const fs::path dir = scratch("transport_unconverged");
+  std::ofstream(dir / "case.yaml") << kCase;
+  write_synthetic_field(dir / "run" / "sample" / "rpm2000" / "field.h5");
+  write_unconverged_sample_report(dir / "run" / "sample" / "rpm2000" / "sample_report.json");
+  const int st = orchestrate("--case " + (dir / "case.yaml").string() +
+                                 " --stage transport --output " + (dir / "run").string(),
+                             dir / "log");
+  EXPECT_NE(st, 0);
+  const std::string log = slurp(dir / "log");
+  for (const char* want : {"flow/rpm2000, which did not converge", "flow.allow_unconverged: true",
+                           "sample_report.json", "flow.max_iterations"})
+    EXPECT_NE(log.find(want), std::string::npos) << want << " not in: " << log;
+  EXPECT_FALSE(fs::exists(dir / "run" / "transport" / "rpm2000" / "summary.json"));
+}
 
 // A time limit shorter than the injection is refused, naming the key.
 TEST(TransportBadInput, TimeLimitBelowDurationNamesKey) {

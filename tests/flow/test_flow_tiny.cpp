@@ -17,6 +17,7 @@
 #include "progress.h"
 #include "stages/flow_stage.h"
 #include "stages/sample_stage.h"
+#include "stages/transport_stage.h"
 
 namespace fs = std::filesystem;
 using namespace mill;
@@ -226,6 +227,19 @@ TEST(FlowTiny, IncompressibleMeshRunSample) {
       const std::string m = e.what();
       for (const char* want : {"flow/rpm2000 did not converge", "flow.allow_unconverged: true",
                                "after 30 iterations", "flow.residual_target"})
+        EXPECT_NE(m.find(want), std::string::npos) << want << " not in: " << m;
+    }
+    // The transport stage refuses the field sampled from it (with the
+    // override) just as well, before any lump moves.
+    TransportStage transport;
+    auto ct = r2.ctx("transport");
+    try {
+      transport.run_job(ct, transport.plan(ct).jobs[0], ct.stage_dir / "jobs" / "rpm2000");
+      FAIL() << "expected the unconverged flow to stop the transport stage";
+    } catch (const std::runtime_error& e) {
+      const std::string m = e.what();
+      for (const char* want : {"flow/rpm2000, which did not converge", "flow.allow_unconverged: true",
+                               "sample_report.json"})
         EXPECT_NE(m.find(want), std::string::npos) << want << " not in: " << m;
     }
     fs::remove(strict);
