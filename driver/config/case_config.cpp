@@ -448,6 +448,18 @@ void check_physics(const Document& d) {
          fmt::format("expected less than gas.pressure ({:g} Pa): the outlet would be at or below vacuum, got {:g} Pa",
                      d.real("gas.pressure"), d.real("gas.outlet_pressure_drop")));
 
+  // In-mill breakage starts from stage 1's strikes and must outlast its lead.
+  if (d.integer("breakage.in_mill.lumps") > 0 && d.str("breakage.conditions") != "transport")
+    fail("breakage.in_mill.lumps",
+         fmt::format("in-mill breakage starts from stage 1's flywheel strikes; expected breakage.conditions: transport "
+                     "(got {}), or breakage.in_mill.lumps: 0, got {}",
+                     d.str("breakage.conditions"), d.integer("breakage.in_mill.lumps")));
+  if (d.real("breakage.in_mill.lead_time") >= d.real("breakage.in_mill.duration"))
+    fail("breakage.in_mill.lead_time",
+         fmt::format("expected shorter than breakage.in_mill.duration ({:g} s): the run would end before the strike, "
+                     "got {:g} s",
+                     d.real("breakage.in_mill.duration"), d.real("breakage.in_mill.lead_time")));
+
   // Breakage: a given time step must be well inside the simulated time.
   const double after = d.real("breakage.duration_after_contact"), bdt = d.real("breakage.timestep");
   if (bdt > after / 10)
