@@ -74,6 +74,9 @@ std::string suggest(const Schema& s, const std::string& path) {
     // Also accept a right leaf under a wrong-looking parent (e.g. "rotor.rmp").
     const std::string cleaf = c.substr(c.rfind('.') == std::string::npos ? 0 : c.rfind('.') + 1);
     d = std::min(d, edit_distance(leaf, cleaf) + (c == path ? 0 : 1));
+    // A shortened key in the right section ("breakage.in_mill.lead").
+    const std::string parent = path.substr(0, path.size() - leaf.size()), cparent = c.substr(0, c.size() - cleaf.size());
+    if (!leaf.empty() && parent == cparent && cleaf.rfind(leaf, 0) == 0) d = std::min<size_t>(d, 1);
     if (d < best_d) {
       best_d = d;
       best = c;
