@@ -12,10 +12,12 @@
 
 namespace mill::post {
 
-std::vector<StrikeStart> SelectStrikeStarts(const std::vector<ImpactRecord>& records, int k, double lead_time_s,
-                                            const RotorMotion& rotor, double min_normal_m_s) {
+std::vector<StrikeStart> SelectStrikeStarts(const std::vector<ImpactRecord>& records, int k,
+                                            double lead_time_s, const RotorMotion& rotor,
+                                            double min_normal_m_s) {
   if (k < 1) throw PostError(fmt::format("lumps to select must be >= 1, got {}", k));
-  if (!(lead_time_s >= 0)) throw PostError(fmt::format("lead time must be >= 0 s, got {:g}", lead_time_s));
+  if (!(lead_time_s >= 0))
+    throw PostError(fmt::format("lead time must be >= 0 s, got {:g}", lead_time_s));
   // Each particle's earliest flywheel strike.
   std::map<long long, const ImpactRecord*> first;
   for (const auto& r : records) {
@@ -24,28 +26,34 @@ std::vector<StrikeStart> SelectStrikeStarts(const std::vector<ImpactRecord>& rec
     if (it == first.end() || r.time_s < it->second->time_s) first[r.particle_id] = &r;
   }
   if (first.empty())
-    throw PostError(fmt::format("no lump struck the flywheel (no flywheel contact with a normal speed of at least "
-                                "{:g} m/s)",
-                                min_normal_m_s));
+    throw PostError(fmt::format(
+        "no lump struck the flywheel (no flywheel contact with a normal speed of at least "
+        "{:g} m/s)",
+        min_normal_m_s));
   std::vector<const ImpactRecord*> strikes;
   for (const auto& [id, r] : first) strikes.push_back(r);
   for (const auto* r : strikes)
-    if (r->contact == std::array<double, 3>{0, 0, 0} && r->relative_velocity == std::array<double, 3>{0, 0, 0})
-      throw PostError(fmt::format("the flywheel strike of particle {} at t = {:g} s has no contact point or relative "
-                                  "velocity (impacts.csv without contact_*_m and vrel_*_m_s columns: rerun the "
-                                  "transport stage)",
-                                  r->particle_id, r->time_s));
-  std::stable_sort(strikes.begin(), strikes.end(), [](const ImpactRecord* a, const ImpactRecord* b) {
-    if (a->normal_speed_m_s != b->normal_speed_m_s) return a->normal_speed_m_s < b->normal_speed_m_s;
-    return a->time_s < b->time_s;
-  });
+    if (r->contact == std::array<double, 3>{0, 0, 0} &&
+        r->relative_velocity == std::array<double, 3>{0, 0, 0})
+      throw PostError(fmt::format(
+          "the flywheel strike of particle {} at t = {:g} s has no contact point or relative "
+          "velocity (impacts.csv without contact_*_m and vrel_*_m_s columns: rerun the "
+          "transport stage)",
+          r->particle_id, r->time_s));
+  std::stable_sort(strikes.begin(), strikes.end(),
+                   [](const ImpactRecord* a, const ImpactRecord* b) {
+                     if (a->normal_speed_m_s != b->normal_speed_m_s)
+                       return a->normal_speed_m_s < b->normal_speed_m_s;
+                     return a->time_s < b->time_s;
+                   });
   std::vector<const ImpactRecord*> chosen;
   const size_t n = strikes.size();
   if (static_cast<size_t>(k) >= n) {
     chosen = strikes;
   } else {
     for (int i = 0; i < k; ++i)
-      chosen.push_back(strikes[std::min(n - 1, static_cast<size_t>((i + 0.5) * static_cast<double>(n) / k))]);
+      chosen.push_back(
+          strikes[std::min(n - 1, static_cast<size_t>((i + 0.5) * static_cast<double>(n) / k))]);
   }
 
   std::vector<StrikeStart> out;
@@ -57,12 +65,13 @@ std::vector<StrikeStart> SelectStrikeStarts(const std::vector<ImpactRecord>& rec
     s.start_time_s = r->time_s - t;
     // Lab velocity: relative velocity plus the beater's Omega x r (axis +z).
     const double rx = r->contact[0] - rotor.origin[0], ry = r->contact[1] - rotor.origin[1];
-    const std::array<double, 3> v = {r->relative_velocity[0] - w * ry, r->relative_velocity[1] + w * rx,
-                                     r->relative_velocity[2]};
+    const std::array<double, 3> v = {r->relative_velocity[0] - w * ry,
+                                     r->relative_velocity[1] + w * rx, r->relative_velocity[2]};
     // Ballistic back-off under gravity (along -y): v0 = v - g_vec t,
     // x0 = x - v t + g_vec t^2 / 2.
     s.velocity = {v[0], v[1] + g * t, v[2]};
-    s.position = {r->position[0] - v[0] * t, r->position[1] - v[1] * t - 0.5 * g * t * t, r->position[2] - v[2] * t};
+    s.position = {r->position[0] - v[0] * t, r->position[1] - v[1] * t - 0.5 * g * t * t,
+                  r->position[2] - v[2] * t};
     double a = std::fmod(w * s.start_time_s, 2 * kPi);
     if (a < 0) a += 2 * kPi;
     s.rotor_angle_rad = a;
@@ -71,7 +80,9 @@ std::vector<StrikeStart> SelectStrikeStarts(const std::vector<ImpactRecord>& rec
     s.strike_angle_deg = r->angle_deg;
     out.push_back(s);
   }
-  std::sort(out.begin(), out.end(), [](const StrikeStart& a, const StrikeStart& b) { return a.particle_id < b.particle_id; });
+  std::sort(out.begin(), out.end(), [](const StrikeStart& a, const StrikeStart& b) {
+    return a.particle_id < b.particle_id;
+  });
   return out;
 }
 
@@ -89,7 +100,8 @@ std::vector<BreakEvent> ReadBreakLog(const std::string& path) {
     std::string mode;
     BreakEvent e;
     if (!(ls >> step >> e.time_s >> x >> y >> z >> mode >> ti >> tj))
-      throw PostError(fmt::format("{}:{}: expected 'step time x y z mode tag_i tag_j ...', got '{}'", path, lineno, line));
+      throw PostError(fmt::format(
+          "{}:{}: expected 'step time x y z mode tag_i tag_j ...', got '{}'", path, lineno, line));
     e.i = std::llround(ti);
     e.j = std::llround(tj);
     out.push_back(e);
@@ -97,7 +109,8 @@ std::vector<BreakEvent> ReadBreakLog(const std::string& path) {
   return out;
 }
 
-BreakSplit SplitBreaks(const std::vector<BreakEvent>& breaks, const std::vector<ImpactRecord>& contacts) {
+BreakSplit SplitBreaks(const std::vector<BreakEvent>& breaks,
+                       const std::vector<ImpactRecord>& contacts) {
   BreakSplit s;
   for (const auto& c : contacts) {
     if (c.surface != "flywheel" && c.surface != "housing") continue;
@@ -106,7 +119,8 @@ BreakSplit SplitBreaks(const std::vector<BreakEvent>& breaks, const std::vector<
   }
   for (const auto& b : breaks) {
     const bool struck = s.first_flywheel_contact_s >= 0 && b.time_s >= s.first_flywheel_contact_s;
-    const bool before_housing = s.first_housing_contact_s < 0 || b.time_s < s.first_housing_contact_s;
+    const bool before_housing =
+        s.first_housing_contact_s < 0 || b.time_s < s.first_housing_contact_s;
     ++(struck && before_housing ? s.at_strike : s.later);
   }
   return s;

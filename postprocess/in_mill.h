@@ -25,14 +25,14 @@ struct RotorMotion {
 // The state of a transport lump `lead_time_s` before its first flywheel strike.
 struct StrikeStart {
   long long particle_id = 0;
-  double strike_time_s = 0;               // time of the first flywheel contact
-  double start_time_s = 0;                // strike_time_s - lead_time_s
-  std::array<double, 3> position{};       // lump centre at start_time_s, m
-  std::array<double, 3> velocity{};       // lab-frame velocity at start_time_s, m/s
-  double rotor_angle_rad = 0;             // flywheel angle at start_time_s, in [0, 2 pi)
-  double strike_speed_m_s = 0;            // speed relative to the beater at the strike
-  double strike_normal_speed_m_s = 0;     // its normal part
-  double strike_angle_deg = 0;            // to the beater surface, 90 = normal
+  double strike_time_s = 0;            // time of the first flywheel contact
+  double start_time_s = 0;             // strike_time_s - lead_time_s
+  std::array<double, 3> position{};    // lump centre at start_time_s, m
+  std::array<double, 3> velocity{};    // lab-frame velocity at start_time_s, m/s
+  double rotor_angle_rad = 0;          // flywheel angle at start_time_s, in [0, 2 pi)
+  double strike_speed_m_s = 0;         // speed relative to the beater at the strike
+  double strike_normal_speed_m_s = 0;  // its normal part
+  double strike_angle_deg = 0;         // to the beater surface, 90 = normal
 };
 
 // Each particle's first flywheel contact (earliest record on "flywheel" with
@@ -45,8 +45,9 @@ struct StrikeStart {
 // beater's Omega x r at the contact point. Sorted by particle id. Throws
 // PostError when no particle struck the flywheel or when the records lack
 // the contact point (an old impacts.csv).
-std::vector<StrikeStart> SelectStrikeStarts(const std::vector<ImpactRecord>& records, int k, double lead_time_s,
-                                            const RotorMotion& rotor, double min_normal_m_s = 0.5);
+std::vector<StrikeStart> SelectStrikeStarts(const std::vector<ImpactRecord>& records, int k,
+                                            double lead_time_s, const RotorMotion& rotor,
+                                            double min_normal_m_s = 0.5);
 
 // One break event of fix bond/breakable's break log.
 struct BreakEvent {
@@ -67,12 +68,13 @@ struct BreakSplit {
   double first_flywheel_contact_s = -1;  // -1: none
   double first_housing_contact_s = -1;   // -1: none
 };
-BreakSplit SplitBreaks(const std::vector<BreakEvent>& breaks, const std::vector<ImpactRecord>& contacts);
+BreakSplit SplitBreaks(const std::vector<BreakEvent>& breaks,
+                       const std::vector<ImpactRecord>& contacts);
 
 // The element contacts of one surface in one run.
 struct ContactTally {
-  long long n = 0;                  // contact onsets
-  long long n_elements = 0;         // distinct elements that touched it
+  long long n = 0;                   // contact onsets
+  long long n_elements = 0;          // distinct elements that touched it
   double normal_speed_mean_m_s = 0;  // over onsets
   double normal_speed_max_m_s = 0;
 };

@@ -74,9 +74,11 @@ def main(argv=None):
 
     rpm = np.array([e["rpm"] for e in data])
     fig, (ax0, ax1, ax2) = plt.subplots(1, 3, figsize=(14, 4.3))
+    colour = {}
     for key, label, style in (("p80_mm", "P80", "o-"), ("p50_mm", "P50", "s--")):
         ys = [e[key] if e[key] is not None else e["sieves_mm"][0] for e in data]
         line, = ax0.plot(rpm, ys, style, label=label)
+        colour[key] = line.get_color()
         below = [(r, y) for r, y, e in zip(rpm, ys, data) if e[key] is None]
         if below:
             ax0.plot([b[0] for b in below], [b[1] for b in below], "o", mfc="white", color=line.get_color(),
@@ -86,7 +88,7 @@ def main(argv=None):
     for key, label, style in (("p80_mm", "P80 in mill", "o:"), ("p50_mm", "P50 in mill", "s:")):
         if mill:
             ys = [e["in_mill"][key] if e["in_mill"][key] is not None else e["in_mill"]["sieves_mm"][0] for e in mill]
-            ax0.plot(mill_rpm, ys, style, mfc="white", label=label)
+            ax0.plot(mill_rpm, ys, style, mfc="white", color=colour[key], label=label)
     ax0.set_xlabel("rotor speed [rpm]")
     ax0.set_ylabel("size [mm]")
     ax0.set_ylim(bottom=0)

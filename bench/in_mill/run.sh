@@ -1,6 +1,7 @@
 #!/bin/sh
 # In-mill breakage benchmark (issue 14); figures go to bench/README.md.
 #   bench/in_mill/run.sh [build-dir]
+#   DURATION=0.005 bench/in_mill/run.sh      a shorter run (s) for comparing settings
 # The reference lump (3344 elements, the reference calibration's bonds) in the
 # reference mill at 2000 rpm for 20 ms on one core: stage 1's impact record is
 # one strike written here (the lump falling at 10 m/s onto plate 0's leading
@@ -43,7 +44,12 @@ open(f"{out}/calibrate/calibrated.yaml", "w").write(
     "  bond_cohesion: 49.0e6\n  bond_friction_angle: 60\n  bond_moment_factor: 0\n"
     f"  input_hash: {h:016x}\n")
 PY
-/usr/bin/time -v "$build/bin/orchestrate" --case "$here/reference_in_mill.yaml" --stage breakage --task 1 \
+case_file="$here/reference_in_mill.yaml"
+if [ -n "${DURATION:-}" ]; then
+  sed "s/duration: 0.02,/duration: $DURATION,/" "$case_file" > "$out.case.yaml"
+  case_file="$out.case.yaml"
+fi
+/usr/bin/time -v "$build/bin/orchestrate" --case "$case_file" --stage breakage --task 1 \
   --output "$out" 2> "$out/in_mill.time" | tee "$out/in_mill.log"
 job="$out/breakage/jobs/rpm2000_mill_p1"
 grep -q '"bond_parameters_origin": "calibrated' "$job/result.json" || echo "WARNING: the bonds were not the calibrated ones"

@@ -24,26 +24,53 @@ using engine::num;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using post::kPi;
 constexpr double kG = 9.81;
 // 1: first version (issue 14).
-constexpr int kInMillDeckVersion = 1;
+// 2: hub of 24 facets, skin of one mean element radius.
+constexpr int kInMillDeckVersion = 2;
+// Facets of the flywheel's hub circle in the in-mill runs (see run_in_mill).
+constexpr int kHubFacets = 24;
+// Neighbour skin in mean element radii: the turning flywheel forces a list
+// build whenever its tips have moved half the skin (every ~25 steps at 0.3
+// radii and 105 m/s); one radius builds 3 x less often (bench/README.md).
+constexpr double kSkinRadii = 1.0;
 // Most an element may move in one step, as a share of the smallest element
 // radius (as for the single impacts).
 constexpr double kStepMove = 0.1;
 
 double omega_of(double rpm) { return rpm * 2 * kPi / 60.0; }
 
-std::array<double, 3> vec3(const nlohmann::json& j) { return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()}; }
+std::array<double, 3> vec3(const nlohmann::json& j) {
+  return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
+}
 
 // The columns of in_mill.csv, in order.
 const std::vector<std::string>& csv_columns() {
-  static const std::vector<std::string> c = {
-      "rpm",          "label",         "particle_id",       "strike_time_s",       "strike_speed_m_s",
-      "strike_angle_deg", "n_elements", "n_pieces",        "n_single",            "largest_mass_fraction",
-      "single_mass_fraction", "t10_percent", "t10_resolved", "broken_bond_fraction", "bonds_broken_at_strike",
-      "bonds_broken_later", "flywheel_contacts", "housing_contacts", "housing_normal_speed_mean_m_s",
-      "mass_rotor", "mass_housing", "mass_outlet", "mass_inlet", "wall_seconds"};
+  static const std::vector<std::string> c = {"rpm",
+                                             "label",
+                                             "particle_id",
+                                             "strike_time_s",
+                                             "strike_speed_m_s",
+                                             "strike_angle_deg",
+                                             "n_elements",
+                                             "n_pieces",
+                                             "n_single",
+                                             "largest_mass_fraction",
+                                             "single_mass_fraction",
+                                             "t10_percent",
+                                             "t10_resolved",
+                                             "broken_bond_fraction",
+                                             "bonds_broken_at_strike",
+                                             "bonds_broken_later",
+                                             "flywheel_contacts",
+                                             "housing_contacts",
+                                             "housing_normal_speed_mean_m_s",
+                                             "mass_rotor",
+                                             "mass_housing",
+                                             "mass_outlet",
+                                             "mass_inlet",
+                                             "wall_seconds"};
   return c;
 }
 
@@ -66,12 +93,17 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan) {
     starts = post::SelectStrikeStarts(post::ReadImpactsCsv(f.string()), static_cast<int>(k),
                                       d.real("breakage.in_mill.lead_time"), rotor);
   } catch (const post::PostError& e) {
-    throw MissingInput(fmt::format("in-mill breakage at {} (breakage.in_mill.lumps {}): {}: {}", rpm_label(rpm), k,
-                                   f.string(), e.what()));
+    throw MissingInput(fmt::format("in-mill breakage at {} (breakage.in_mill.lumps {}): {}: {}",
+                                   rpm_label(rpm), k, f.string(), e.what()));
   }
   const bool gas = d.boolean("breakage.in_mill.gas");
-  std::vector<std::string> keys = {"lump.", "mill.", "breakage.timestep", "breakage.dump_interval",
-                                   "breakage.in_mill.duration", "breakage.in_mill.lead_time", "breakage.in_mill.gas",
+  std::vector<std::string> keys = {"lump.",
+                                   "mill.",
+                                   "breakage.timestep",
+                                   "breakage.dump_interval",
+                                   "breakage.in_mill.duration",
+                                   "breakage.in_mill.lead_time",
+                                   "breakage.in_mill.gas",
                                    "breakage.in_mill.neighbour_bins"};
   if (gas)
     for (const char* p : {"gas.", "flow.", "sample."}) keys.push_back(p);
@@ -94,11 +126,13 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan) {
     in["strike_speed_m_s"] = s.strike_speed_m_s;
     in["strike_normal_speed_m_s"] = s.strike_normal_speed_m_s;
     in["strike_angle_deg"] = s.strike_angle_deg;
-    plan.jobs.push_back({fmt::format("{}_mill_p{}", rpm_label(rpm), s.particle_id), in,
-                         fmt::format("{} in-mill: lump {} of stage 1 from {:g} ms before its flywheel strike at {:.1f} "
-                                     "m/s ({:.0f} deg), {:g} ms in the mill",
-                                     rpm_label(rpm), s.particle_id, 1e3 * d.real("breakage.in_mill.lead_time"),
-                                     s.strike_speed_m_s, s.strike_angle_deg, 1e3 * d.real("breakage.in_mill.duration"))});
+    plan.jobs.push_back(
+        {fmt::format("{}_mill_p{}", rpm_label(rpm), s.particle_id), in,
+         fmt::format(
+             "{} in-mill: lump {} of stage 1 from {:g} ms before its flywheel strike at {:.1f} "
+             "m/s ({:.0f} deg), {:g} ms in the mill",
+             rpm_label(rpm), s.particle_id, 1e3 * d.real("breakage.in_mill.lead_time"),
+             s.strike_speed_m_s, s.strike_angle_deg, 1e3 * d.real("breakage.in_mill.duration"))});
   }
 }
 
@@ -112,7 +146,8 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
   const fs::path field_file = ctx.run_dir / "sample" / rpm_label(rpm) / "field.h5";
   if (gas && !fs::exists(field_file))
     throw MissingInput(fmt::format(
-        "in-mill breakage ({}) needs {} (the sampled gas field at {:g} rpm, breakage.in_mill.gas: true); make it with "
+        "in-mill breakage ({}) needs {} (the sampled gas field at {:g} rpm, breakage.in_mill.gas: "
+        "true); make it with "
         "`orchestrate --case {} --stage sample --output {}`, or set breakage.in_mill.gas: false",
         label, field_file.string(), rpm, d.file(), ctx.run_dir.string()));
 
@@ -120,15 +155,22 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
   // The mill, its flywheel turned to its angle at the start.
   geometry::MillGeometry g = geometry::MillGeometry::from_config(d);
   g.rotor_angle = in.at("rotor_angle_rad").get<double>();
+  // The hub circle drawn with kHubFacets instead of 96 facets: the impact
+  // recorder tests every element against every facet at each step (816
+  // facets took half the run time); the polygon departs from the circle by
+  // r (1 - cos(pi / kHubFacets)), 1.3 mm on a 0.3 m hub.
+  g.arc_segments = kHubFacets;
   fs::create_directories(lr.work);
   const geometry::StlSet stl = geometry::write_stl_set(g, lr.work / "stl");
 
   // Neighbour bins: the box holds the whole mill, so the bins start large
   // enough that it holds at most neighbour_bins of them.
   const double margin = 0.05;
-  const double box_volume = (g.width + 2 * margin) * (g.height + 2 * margin) * (g.depth + 2 * margin);
-  const double bin0 = std::max(4.0 * lr.lump.mean_radius,
-                               std::cbrt(box_volume / static_cast<double>(d.integer("breakage.in_mill.neighbour_bins"))));
+  const double box_volume =
+      (g.width + 2 * margin) * (g.height + 2 * margin) * (g.depth + 2 * margin);
+  const double bin0 = std::max(
+      4.0 * lr.lump.mean_radius,
+      std::cbrt(box_volume / static_cast<double>(d.integer("breakage.in_mill.neighbour_bins"))));
   // The fastest an element is expected to move: its start speed plus twice
   // the rim speed (flung by a beater, elastic at most).
   const auto x0 = vec3(in.at("position")), v0 = vec3(in.at("velocity"));
@@ -136,11 +178,14 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
   const double dt_speed = kStepMove * lr.r_min / v_max;
   const double dt_given = d.real("breakage.timestep");
   if (dt_given > dt_speed)
-    throw std::runtime_error(fmt::format(
-        "{}: at up to {:.0f} m/s (start speed plus twice the rim speed) an element moves {:.3g} m per step of {:g} s, "
-        "more than {:g} of the smallest element radius ({:.3g} m); expected breakage.timestep <= {:.3g} s, or 0 "
-        "(automatic)",
-        d.where("breakage.timestep"), v_max, v_max * dt_given, dt_given, kStepMove, lr.r_min, dt_speed));
+    throw std::runtime_error(
+        fmt::format("{}: at up to {:.0f} m/s (start speed plus twice the rim speed) an element "
+                    "moves {:.3g} m per step of {:g} s, "
+                    "more than {:g} of the smallest element radius ({:.3g} m); expected "
+                    "breakage.timestep <= {:.3g} s, or 0 "
+                    "(automatic)",
+                    d.where("breakage.timestep"), v_max, v_max * dt_given, dt_given, kStepMove,
+                    lr.r_min, dt_speed));
 
   engine::DeckRun run;
   run.deck = ctx.cfg.project_dir / "liggghts_inputs" / "in_mill.in.tmpl";
@@ -165,29 +210,35 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
               {"t_end", num(d.real("breakage.in_mill.duration"))},
               {"dt", num(dt_given)},
               {"dt_speed", num(dt_speed)},
-              {"skin", num(0.3 * lr.lump.mean_radius)},
+              {"skin", num(kSkinRadii * lr.lump.mean_radius)},
               {"binsize", num(bin0)},
               {"dump_interval", num(d.real("breakage.dump_interval"))}};
   for (const auto& kv : lump_deck_vars(ctx, lr)) run.vars.push_back(kv);
   const engine::Result res = engine::run_deck(ctx.runner, run, ctx.progress, label);
 
   // Fragments, judged at the strike's relative speed (its specific energy).
-  const double v_strike = in.at("strike_speed_m_s").get<double>(), a_strike = in.at("strike_angle_deg").get<double>();
-  const LumpRunResult a = analyse_lump_run(ctx, lr, {v_strike, std::clamp(a_strike, 0.0, 90.0), repeat}, res.seconds, label);
+  const double v_strike = in.at("strike_speed_m_s").get<double>(),
+               a_strike = in.at("strike_angle_deg").get<double>();
+  const LumpRunResult a = analyse_lump_run(
+      ctx, lr, {v_strike, std::clamp(a_strike, 0.0, 90.0), repeat}, res.seconds, label);
   // Walls are impenetrable: an element outside the housing's sides passed
   // through a wall between steps (the floor and roof have openings).
-  const long through = std::count_if(a.snap.elements.begin(), a.snap.elements.end(), [&](const post::Element& e) {
-    return std::abs(e.x[0]) > 0.5 * g.width || std::abs(e.x[2]) > 0.5 * g.depth;
-  });
+  const long through =
+      std::count_if(a.snap.elements.begin(), a.snap.elements.end(), [&](const post::Element& e) {
+        return std::abs(e.x[0]) > 0.5 * g.width || std::abs(e.x[2]) > 0.5 * g.depth;
+      });
   if (through > 0)
-    throw std::runtime_error(fmt::format("{}: {} of {} elements ended outside the housing's side walls: they passed "
-                                         "through a wall between steps, the run is invalid; log: {}",
-                                         label, through, a.snap.elements.size(), (lr.work / "liggghts.log").string()));
+    throw std::runtime_error(
+        fmt::format("{}: {} of {} elements ended outside the housing's side walls: they passed "
+                    "through a wall between steps, the run is invalid; log: {}",
+                    label, through, a.snap.elements.size(), (lr.work / "liggghts.log").string()));
 
   // The record: contacts, bonds broken at the strike and later, mass places.
   const auto contacts = post::ReadImpactsCsv((lr.work / "impacts.csv").string());
-  const auto split = post::SplitBreaks(post::ReadBreakLog((lr.work / "breaks.txt").string()), contacts);
-  const auto fly = post::TallyContacts(contacts, "flywheel"), wall = post::TallyContacts(contacts, "housing");
+  const auto split =
+      post::SplitBreaks(post::ReadBreakLog((lr.work / "breaks.txt").string()), contacts);
+  const auto fly = post::TallyContacts(contacts, "flywheel"),
+             wall = post::TallyContacts(contacts, "housing");
   post::MillRegions regions;
   regions.axis_x = g.axis_x;
   regions.axis_y = g.axis_height;
@@ -209,15 +260,17 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
   const auto when = [](double t) { return t >= 0 ? nlohmann::json(t) : nlohmann::json(nullptr); };
   j["mode"] = "in_mill";
   j["rpm"] = rpm;
-  j["start"] = {{"particle_id", in.at("particle_id")},
-                {"time_in_transport_s", in.at("start_time_s")},
-                {"strike_time_in_transport_s", in.at("strike_time_s")},
-                {"position_m", in.at("position")},
-                {"velocity_m_s", in.at("velocity")},
-                {"rotor_angle_deg", in.at("rotor_angle_rad").get<double>() * 180 / kPi},
-                {"lead_time_s", d.real("breakage.in_mill.lead_time")},
-                {"note", "the transport lump's state at its first flywheel strike, backed off ballistically (gravity "
-                         "only) by lead_time"}};
+  j["start"] = {
+      {"particle_id", in.at("particle_id")},
+      {"time_in_transport_s", in.at("start_time_s")},
+      {"strike_time_in_transport_s", in.at("strike_time_s")},
+      {"position_m", in.at("position")},
+      {"velocity_m_s", in.at("velocity")},
+      {"rotor_angle_deg", in.at("rotor_angle_rad").get<double>() * 180 / kPi},
+      {"lead_time_s", d.real("breakage.in_mill.lead_time")},
+      {"note",
+       "the transport lump's state at its first flywheel strike, backed off ballistically (gravity "
+       "only) by lead_time"}};
   j["strike"] = {{"speed_m_s", v_strike},
                  {"normal_speed_m_s", in.at("strike_normal_speed_m_s")},
                  {"angle_deg", a_strike}};
@@ -229,22 +282,29 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
   j["first_flywheel_contact_s"] = when(split.first_flywheel_contact_s);
   j["first_housing_contact_s"] = when(split.first_housing_contact_s);
   j["strike_definition"] =
-      "at the strike: broken from the lump's first element contact with the flywheel until the first element "
+      "at the strike: broken from the lump's first element contact with the flywheel until the "
+      "first element "
       "contact with the housing; later: after it (housing impacts and later strikes)";
   j["flywheel"] = tally(fly);
   j["housing"] = tally(wall);
-  j["mass_places"] = {{"rotor", mass.rotor}, {"housing", mass.housing}, {"outlet", mass.outlet}, {"inlet", mass.inlet}};
+  j["mass_places"] = {{"rotor", mass.rotor},
+                      {"housing", mass.housing},
+                      {"outlet", mass.outlet},
+                      {"inlet", mass.inlet}};
   jobs::atomic_write(out_dir / "in_mill.json", j.dump(2) + "\n");
   write_lump_outputs(out_dir, a, j);
 
   const auto& s = a.result.summary;
   return fmt::format(
-      "lump {} struck at {:.1f} m/s ({:.0f} deg): {} pieces ({} single), largest {:.1f}%, t10 {:.1f}%{}; bonds broken "
-      "{:.1f}% ({} at the strike, {} later); {} flywheel and {} housing contacts; mass in the rotor region {:.0f}%, "
+      "lump {} struck at {:.1f} m/s ({:.0f} deg): {} pieces ({} single), largest {:.1f}%, t10 "
+      "{:.1f}%{}; bonds broken "
+      "{:.1f}% ({} at the strike, {} later); {} flywheel and {} housing contacts; mass in the "
+      "rotor region {:.0f}%, "
       "housing {:.0f}%, below the floor {:.0f}% [{:.1f} s]",
-      in.at("particle_id").get<long long>(), v_strike, a_strike, s.n_pieces, s.n_single, 100 * s.largest_mass_fraction,
-      s.t10_percent, s.t10_resolved ? "" : " (unresolved)", 100 * s.broken_bond_fraction, split.at_strike, split.later,
-      fly.n, wall.n, 100 * mass.rotor, 100 * mass.housing, 100 * mass.outlet, res.seconds);
+      in.at("particle_id").get<long long>(), v_strike, a_strike, s.n_pieces, s.n_single,
+      100 * s.largest_mass_fraction, s.t10_percent, s.t10_resolved ? "" : " (unresolved)",
+      100 * s.broken_bond_fraction, split.at_strike, split.later, fly.n, wall.n, 100 * mass.rotor,
+      100 * mass.housing, 100 * mass.outlet, res.seconds);
 }
 
 std::string damaged_in_mill_outputs(const fs::path& dir) {
@@ -252,7 +312,8 @@ std::string damaged_in_mill_outputs(const fs::path& dir) {
   return jobs::check_json(dir / "in_mill.json");
 }
 
-std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx, const std::vector<JobSpec>& jobs) {
+std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
+                                                       const std::vector<JobSpec>& jobs) {
   const jobs::JobStore store(ctx.stage_dir);
   const auto edges = ctx.cfg.doc.reals("breakage.size_fraction_edges");
   const double d_mm = 1000 * ctx.cfg.doc.real("lump.diameter");
@@ -291,20 +352,24 @@ std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx, const 
     a.housing += m.at("housing").get<double>();
     a.outlet += m.at("outlet").get<double>();
     a.inlet += m.at("inlet").get<double>();
-    csv += fmt::format("{:g},{},{},{:.9g},{:.6g},{:.6g},{},{},{},{:.9g},{:.9g},{:.6g},{},{:.9g},{},{},{},{},{:.6g},{:.6g},"
-                       "{:.6g},{:.6g},{:.6g},{:.3f}\n",
-                       rpm, job.label, j.at("start").at("particle_id").get<long long>(),
-                       j.at("start").at("strike_time_in_transport_s").get<double>(), j.at("strike").at("speed_m_s").get<double>(),
-                       j.at("strike").at("angle_deg").get<double>(), j.at("lump").at("elements").get<long>(),
-                       j.at("n_pieces").get<long long>(), j.at("n_single").get<long long>(),
-                       j.at("largest_mass_fraction").get<double>(), j.at("single_mass_fraction").get<double>(),
-                       j.at("t10_percent").get<double>(), j.at("t10_resolved").get<bool>() ? 1 : 0,
-                       j.at("broken_bond_fraction").get<double>(), j.at("bonds_broken_at_strike").get<long long>(),
-                       j.at("bonds_broken_later").get<long long>(), j.at("flywheel").at("contacts").get<long long>(),
-                       j.at("housing").at("contacts").get<long long>(),
-                       j.at("housing").at("normal_speed_mean_m_s").get<double>(), m.at("rotor").get<double>(),
-                       m.at("housing").get<double>(), m.at("outlet").get<double>(), m.at("inlet").get<double>(),
-                       j.at("wall_seconds").get<double>());
+    csv += fmt::format(
+        "{:g},{},{},{:.9g},{:.6g},{:.6g},{},{},{},{:.9g},{:.9g},{:.6g},{},{:.9g},{},{},{},{},{:.6g}"
+        ",{:.6g},"
+        "{:.6g},{:.6g},{:.6g},{:.3f}\n",
+        rpm, job.label, j.at("start").at("particle_id").get<long long>(),
+        j.at("start").at("strike_time_in_transport_s").get<double>(),
+        j.at("strike").at("speed_m_s").get<double>(), j.at("strike").at("angle_deg").get<double>(),
+        j.at("lump").at("elements").get<long>(), j.at("n_pieces").get<long long>(),
+        j.at("n_single").get<long long>(), j.at("largest_mass_fraction").get<double>(),
+        j.at("single_mass_fraction").get<double>(), j.at("t10_percent").get<double>(),
+        j.at("t10_resolved").get<bool>() ? 1 : 0, j.at("broken_bond_fraction").get<double>(),
+        j.at("bonds_broken_at_strike").get<long long>(),
+        j.at("bonds_broken_later").get<long long>(),
+        j.at("flywheel").at("contacts").get<long long>(),
+        j.at("housing").at("contacts").get<long long>(),
+        j.at("housing").at("normal_speed_mean_m_s").get<double>(), m.at("rotor").get<double>(),
+        m.at("housing").get<double>(), m.at("outlet").get<double>(), m.at("inlet").get<double>(),
+        j.at("wall_seconds").get<double>());
   }
   std::map<double, nlohmann::json> out;
   if (by_rpm.empty()) return out;
@@ -313,25 +378,33 @@ std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx, const 
     const double n = a.n;
     for (auto& f : a.frac) f /= n;
     const long long broken = a.at_strike + a.later;
-    nlohmann::json e = {{"lumps", a.n},
-                        {"fraction_mass", a.frac},
-                        {"fully_shredded_mass_fraction", a.single / n},
-                        {"largest_piece_mass_fraction", a.largest / n},
-                        {"t10_percent", a.t10 / n},
-                        {"t10_resolved", a.resolved},
-                        {"bonds_broken_at_strike_fraction",
-                         broken > 0 ? nlohmann::json(static_cast<double>(a.at_strike) / broken) : nlohmann::json(nullptr)},
-                        {"mass_places", {{"rotor", a.rotor / n}, {"housing", a.housing / n}, {"outlet", a.outlet / n},
-                                         {"inlet", a.inlet / n}}},
-                        {"duration_s", ctx.cfg.doc.real("breakage.in_mill.duration")},
-                        {"note", "bonded lumps run in the turning mill from their first flywheel strike in stage 1: "
-                                 "the strike, the flight and the housing impacts (breakage/in_mill.csv per run)"}};
+    nlohmann::json e = {
+        {"lumps", a.n},
+        {"fraction_mass", a.frac},
+        {"fully_shredded_mass_fraction", a.single / n},
+        {"largest_piece_mass_fraction", a.largest / n},
+        {"t10_percent", a.t10 / n},
+        {"t10_resolved", a.resolved},
+        {"bonds_broken_at_strike_fraction",
+         broken > 0 ? nlohmann::json(static_cast<double>(a.at_strike) / broken)
+                    : nlohmann::json(nullptr)},
+        {"mass_places",
+         {{"rotor", a.rotor / n},
+          {"housing", a.housing / n},
+          {"outlet", a.outlet / n},
+          {"inlet", a.inlet / n}}},
+        {"duration_s", ctx.cfg.doc.real("breakage.in_mill.duration")},
+        {"note",
+         "bonded lumps run in the turning mill from their first flywheel strike in stage 1: "
+         "the strike, the flight and the housing impacts (breakage/in_mill.csv per run)"}};
     e.update(passing_json(sieves, a.frac));
     out[rpm] = e;
     ctx.progress.info(fmt::format(
-        "[breakage] in-mill product at {:g} rpm ({} lumps): fully shredded {:.1f}% of the mass, largest piece {:.1f}%, "
+        "[breakage] in-mill product at {:g} rpm ({} lumps): fully shredded {:.1f}% of the mass, "
+        "largest piece {:.1f}%, "
         "t10 {:.1f}%{}, {} of the broken bonds broke at the beater strike",
-        rpm, a.n, 100 * a.single / n, 100 * a.largest / n, a.t10 / n, a.resolved ? "" : " (unresolved)",
+        rpm, a.n, 100 * a.single / n, 100 * a.largest / n, a.t10 / n,
+        a.resolved ? "" : " (unresolved)",
         broken > 0 ? fmt::format("{:.0f}%", 100.0 * a.at_strike / broken) : std::string("none")));
   }
   return out;

@@ -6,10 +6,9 @@
 // (an `in_mill` object per rotor speed) and breakage/in_mill.csv.
 #pragma once
 
-#include <nlohmann/json.hpp>
-
 #include <filesystem>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -25,13 +24,15 @@ bool is_in_mill_job(const JobSpec& job);
 void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan);
 
 // Runs one in-mill job into out_dir; returns its summary line.
-std::string run_in_mill(StageContext& ctx, const JobSpec& job, const std::filesystem::path& out_dir);
+std::string run_in_mill(StageContext& ctx, const JobSpec& job,
+                        const std::filesystem::path& out_dir);
 
 // The outputs run_in_mill writes exist and parse: "" or the reason.
 std::string damaged_in_mill_outputs(const std::filesystem::path& dir);
 
 // breakage/in_mill.csv (one row per run) and, per rotor speed, the in-mill
 // product object of product.json (averaged over the runs).
-std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx, const std::vector<JobSpec>& jobs);
+std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
+                                                       const std::vector<JobSpec>& jobs);
 
 }  // namespace mill

@@ -6,10 +6,9 @@
 // fragments.vtp, result.json), each complete or absent.
 #pragma once
 
-#include <nlohmann/json.hpp>
-
 #include <array>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -38,7 +37,8 @@ LumpRun prepare_lump_run(StageContext& ctx, int repeat, const std::filesystem::p
 
 // -var pairs every lump deck takes: the shared deck pieces' folder, the lump
 // file, its orientation, the bonding rule, the ore and the bonds.
-std::vector<std::pair<std::string, std::string>> lump_deck_vars(const StageContext& ctx, const LumpRun& run);
+std::vector<std::pair<std::string, std::string>> lump_deck_vars(const StageContext& ctx,
+                                                                const LumpRun& run);
 
 struct LumpRunResult {
   post::DumpSnapshot snap;
@@ -47,16 +47,19 @@ struct LumpRunResult {
 
 // Reads the run's bonds_initial.txt, final.dump and bonds_final.txt (in
 // run.work) and analyses the fragments. Throws when elements were lost.
-LumpRunResult analyse_lump_run(StageContext& ctx, const LumpRun& run, const post::ImpactConditions& conditions,
-                               double wall_seconds, const std::string& label);
+LumpRunResult analyse_lump_run(StageContext& ctx, const LumpRun& run,
+                               const post::ImpactConditions& conditions, double wall_seconds,
+                               const std::string& label);
 
 // result.json of a run: the conditions, the lump, the bonds and the fragment
 // summary (callers add their own keys).
-nlohmann::json lump_result_json(const LumpRun& run, const post::ImpactResult& r, double wall_seconds);
+nlohmann::json lump_result_json(const LumpRun& run, const post::ImpactResult& r,
+                                double wall_seconds);
 
 // Writes summary.csv, fractions.csv, impact.h5, fragments.vtp and
 // result.json into out_dir, each complete or absent.
-void write_lump_outputs(const std::filesystem::path& out_dir, const LumpRunResult& a, const nlohmann::json& result);
+void write_lump_outputs(const std::filesystem::path& out_dir, const LumpRunResult& a,
+                        const nlohmann::json& result);
 
 // The outputs write_lump_outputs writes exist and parse: "" or the reason.
 std::string damaged_lump_outputs(const std::filesystem::path& dir);

@@ -5,9 +5,8 @@
 // broke at the strike, the other only against the housing (and the record
 // says none broke at the strike), element mass is conserved, and
 // product.json and in_mill.csv hold the in-mill product.
-#include <gtest/gtest.h>
-
 #include <fmt/format.h>
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <nlohmann/json.hpp>
@@ -29,18 +28,18 @@ constexpr double kPi = 3.14159265358979323846;
 
 // One impacts.csv row: lump `id` at `x`, lab velocity `v`, contact point `c`
 // on the flywheel (axis at (0, 0.45), 2000 rpm), normal `n`.
-std::string row(int id, double t, std::array<double, 3> x, std::array<double, 3> v, std::array<double, 3> c,
-                std::array<double, 3> n) {
+std::string row(int id, double t, std::array<double, 3> x, std::array<double, 3> v,
+                std::array<double, 3> c, std::array<double, 3> n) {
   const double w = 2000 * 2 * kPi / 60;
   const double rx = c[0], ry = c[1] - 0.45;
   const std::array<double, 3> vr = {v[0] + w * ry, v[1] - w * rx, v[2]};
   const double speed = std::hypot(vr[0], vr[1], vr[2]);
   const double vn = std::max(0.6, -(vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2]));
   const double vt = std::sqrt(std::max(0.0, speed * speed - vn * vn));
-  return fmt::format("{},{},flywheel,{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", t, id, x[0], x[1], x[2],
-                     c[0], c[1], c[2], n[0], n[1], n[2], vr[0], vr[1], vr[2], speed, vn, vt,
-                     std::asin(std::min(1.0, vn / speed)) * 180 / kPi, w * std::hypot(rx, ry),
-                     std::hypot(v[0], v[1], v[2]), std::hypot(rx, ry));
+  return fmt::format("{},{},flywheel,{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", t,
+                     id, x[0], x[1], x[2], c[0], c[1], c[2], n[0], n[1], n[2], vr[0], vr[1], vr[2],
+                     speed, vn, vt, std::asin(std::min(1.0, vn / speed)) * 180 / kPi,
+                     w * std::hypot(rx, ry), std::hypot(v[0], v[1], v[2]), std::hypot(rx, ry));
 }
 
 // Lump 1: falling at 5 m/s onto plate 0's leading face, which points up at
@@ -50,8 +49,10 @@ void write_transport_impacts(const fs::path& run) {
   fs::create_directories(run / "transport/rpm2000");
   const double t = 0.5 * kPi / (2000 * 2 * kPi / 60);
   spit(run / "transport/rpm2000/impacts.csv",
-       "time_s,particle_id,surface,x_m,y_m,z_m,contact_x_m,contact_y_m,contact_z_m,normal_x,normal_y,normal_z,"
-       "vrel_x_m_s,vrel_y_m_s,vrel_z_m_s,speed_m_s,normal_speed_m_s,tangential_speed_m_s,angle_deg,surface_speed_m_s,"
+       "time_s,particle_id,surface,x_m,y_m,z_m,contact_x_m,contact_y_m,contact_z_m,normal_x,normal_"
+       "y,normal_z,"
+       "vrel_x_m_s,vrel_y_m_s,vrel_z_m_s,speed_m_s,normal_speed_m_s,tangential_speed_m_s,angle_deg,"
+       "surface_speed_m_s,"
        "particle_speed_m_s,axis_distance_m\n" +
            row(1, t, {-0.021, 0.62, 0}, {0, -5, 0}, {-0.01, 0.62, 0}, {-1, 0, 0}) +
            row(2, t, {0.2, 0.95, 0}, {60, 0, 0}, {0.2, 0.94, 0}, {0, 1, 0}));
@@ -80,13 +81,17 @@ TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAK
   const fs::path dir = scratch("in_mill");
   write_transport_impacts(dir);
   const std::string yaml = kData + "/tiny_in_mill.yaml";
-  ASSERT_EQ(orchestrate("--case " + yaml + " --stage breakage --list-tasks --output " + dir.string(), dir / "tasks.log"), 0)
+  ASSERT_EQ(
+      orchestrate("--case " + yaml + " --stage breakage --list-tasks --output " + dir.string(),
+                  dir / "tasks.log"),
+      0)
       << slurp(dir / "tasks.log");
   for (const char* l : {"rpm2000_mill_p1", "rpm2000_mill_p2"})
     EXPECT_NE(slurp(dir / "tasks.log").find(l), std::string::npos) << slurp(dir / "tasks.log");
 
   // Killed while the second in-mill run is going.
-  const std::vector<std::string> args = {"--case", yaml, "--stage", "breakage", "--jobs", "1", "--output", dir.string()};
+  const std::vector<std::string> args = {"--case", yaml, "--stage",  "breakage",
+                                         "--jobs", "1",  "--output", dir.string()};
   const pid_t pid = spawn_orchestrate(args, dir / "killed.log");
   const fs::path stage = dir / "breakage";
   const bool ready = wait_for(
@@ -105,8 +110,10 @@ TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAK
   std::string line;
   for (const auto& a : args) line += "'" + a + "' ";
   ASSERT_EQ(orchestrate(line, dir / "resumed.log"), 0) << slurp(dir / "resumed.log");
-  EXPECT_EQ(fs::last_write_time(stage / "jobs/rpm2000_mill_p1/STATUS"), t_first) << "the finished run was redone";
-  EXPECT_NE(slurp(dir / "resumed.log").find("2 already done"), std::string::npos) << slurp(dir / "resumed.log");
+  EXPECT_EQ(fs::last_write_time(stage / "jobs/rpm2000_mill_p1/STATUS"), t_first)
+      << "the finished run was redone";
+  EXPECT_NE(slurp(dir / "resumed.log").find("2 already done"), std::string::npos)
+      << slurp(dir / "resumed.log");
 
   // The struck lump: the beater broke it.
   const auto struck = nlohmann::json::parse(slurp(stage / "jobs/rpm2000_mill_p1/in_mill.json"));
@@ -124,13 +131,15 @@ TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAK
     const fs::path jd = stage / "jobs" / l;
     const auto j = nlohmann::json::parse(slurp(jd / "in_mill.json"));
     const fs::path lump_file =
-        mill::jobs::JobStore(stage / "lumps").job_dir(j.at("lump").at("label").get<std::string>()) / "lump.data";
+        mill::jobs::JobStore(stage / "lumps").job_dir(j.at("lump").at("label").get<std::string>()) /
+        "lump.data";
     ASSERT_TRUE(fs::exists(lump_file)) << lump_file;
     const double m0 = data_file_mass(lump_file);
     // The data file and the dump carry about 7 significant digits.
     EXPECT_NEAR(j.at("element_mass_kg").get<double>(), m0, 1e-6 * m0) << l;
     double sum = 0;
-    for (const auto& f : mill::post::ReadFractionsCsv((jd / "fractions.csv").string())) sum += f.mass_fraction;
+    for (const auto& f : mill::post::ReadFractionsCsv((jd / "fractions.csv").string()))
+      sum += f.mass_fraction;
     EXPECT_NEAR(sum, 1.0, 1e-9) << l;
     const auto& places = j.at("mass_places");
     EXPECT_NEAR(places.at("rotor").get<double>() + places.at("housing").get<double>() +
@@ -144,8 +153,9 @@ TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAK
   ASSERT_EQ(product.size(), 1u);
   const auto& m = product[0].at("in_mill");
   EXPECT_EQ(m.at("lumps").get<int>(), 2);
-  for (const char* k : {"fully_shredded_mass_fraction", "largest_piece_mass_fraction", "t10_percent", "t10_resolved",
-                        "bonds_broken_at_strike_fraction", "passing_percent"})
+  for (const char* k :
+       {"fully_shredded_mass_fraction", "largest_piece_mass_fraction", "t10_percent",
+        "t10_resolved", "bonds_broken_at_strike_fraction", "passing_percent"})
     EXPECT_TRUE(m.contains(k)) << k;
   EXPECT_TRUE(product[0].contains("fully_shredded_mass_fraction"));
   std::istringstream csv(slurp(stage / "in_mill.csv"));

@@ -34,8 +34,9 @@ RotorMotion rotor(double omega) {
 TEST(SelectStrikeStarts, FirstFlywheelStrikeOfEachLump) {
   // Lump 1 strikes twice: its earlier strike counts; housing contacts and a
   // resting touch do not.
-  const std::vector<ImpactRecord> recs = {strike(1, 0.30, "flywheel", 40), strike(1, 0.10, "flywheel", 20),
-                                          strike(2, 0.05, "housing", 30), strike(2, 0.20, "flywheel", 0.1)};
+  const std::vector<ImpactRecord> recs = {
+      strike(1, 0.30, "flywheel", 40), strike(1, 0.10, "flywheel", 20),
+      strike(2, 0.05, "housing", 30), strike(2, 0.20, "flywheel", 0.1)};
   const auto s = SelectStrikeStarts(recs, 5, 0.0, rotor(0.0));
   ASSERT_EQ(s.size(), 1u);
   EXPECT_EQ(s[0].particle_id, 1);
@@ -83,14 +84,17 @@ TEST(SelectStrikeStarts, ErrorsSayWhatIsMissing) {
     SelectStrikeStarts({old}, 1, 1e-3, rotor(100));
     FAIL() << "no error";
   } catch (const PostError& e) {
-    EXPECT_NE(std::string(e.what()).find("rerun the transport stage"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("rerun the transport stage"), std::string::npos)
+        << e.what();
   }
 }
 
 TEST(SplitBreaks, StrikeUntilTheFirstHousingContact) {
-  const std::vector<ImpactRecord> contacts = {strike(5, 0.002, "flywheel", 30), strike(9, 0.006, "housing", 50),
+  const std::vector<ImpactRecord> contacts = {strike(5, 0.002, "flywheel", 30),
+                                              strike(9, 0.006, "housing", 50),
                                               strike(5, 0.008, "flywheel", 10)};
-  const std::vector<BreakEvent> breaks = {{0.0021, 1, 2}, {0.004, 2, 3}, {0.0065, 3, 4}, {0.01, 4, 5}};
+  const std::vector<BreakEvent> breaks = {
+      {0.0021, 1, 2}, {0.004, 2, 3}, {0.0065, 3, 4}, {0.01, 4, 5}};
   const auto s = SplitBreaks(breaks, contacts);
   EXPECT_EQ(s.at_strike, 2);
   EXPECT_EQ(s.later, 2);
@@ -147,8 +151,8 @@ TEST(LocateMass, SharesOfTheMassByPlace) {
     e.mass = m;
     return e;
   };
-  const auto m = LocateMass({el(0.2, 1.2, 0, 1), el(0.7, 1.2, 0, 1), el(0.2, 1.2, 0.2, 1), el(0, -0.1, 0, 0.5),
-                             el(0, 4.1, 0, 0.5)},
+  const auto m = LocateMass({el(0.2, 1.2, 0, 1), el(0.7, 1.2, 0, 1), el(0.2, 1.2, 0.2, 1),
+                             el(0, -0.1, 0, 0.5), el(0, 4.1, 0, 0.5)},
                             g);
   EXPECT_DOUBLE_EQ(m.rotor, 0.25);
   EXPECT_DOUBLE_EQ(m.housing, 0.5);
