@@ -162,6 +162,12 @@ TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAK
   int rows = 0;
   while (std::getline(csv, line)) ++rows;
   EXPECT_EQ(rows, 3);  // header and two runs
+
+  // The report's headline has the in-mill row beside the single impact's.
+  ASSERT_EQ(orchestrate("--case " + yaml + " --stage report --output " + dir.string(), dir / "report.log"), 0)
+      << slurp(dir / "report.log");
+  EXPECT_NE(slurp(dir / "report/index.html").find("in the mill (2 lumps, strike and housing impacts), 2000 rpm"),
+            std::string::npos);
 }
 
 }  // namespace
