@@ -400,10 +400,10 @@ std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
     e.update(passing_json(sieves, a.frac));
     out[rpm] = e;
     ctx.progress.info(fmt::format(
-        "[breakage] in-mill product at {:g} rpm ({} lumps): fully shredded {:.1f}% of the mass, "
+        "[breakage] in-mill product at {:g} rpm ({} lump{}): fully shredded {:.1f}% of the mass, "
         "largest piece {:.1f}%, "
         "t10 {:.1f}%{}, {} of the broken bonds broke at the beater strike",
-        rpm, a.n, 100 * a.single / n, 100 * a.largest / n, a.t10 / n,
+        rpm, a.n, a.n == 1 ? "" : "s", 100 * a.single / n, 100 * a.largest / n, a.t10 / n,
         a.resolved ? "" : " (unresolved)",
         broken > 0 ? fmt::format("{:.0f}%", 100.0 * a.at_strike / broken) : std::string("none")));
   }

@@ -14,6 +14,7 @@
 
 #include "e2e_util.h"
 #include "postprocess/breakage_results.h"
+#include "postprocess/flow_field_io.h"
 #include "postprocess/lammps_dump.h"
 
 namespace fs = std::filesystem;
@@ -164,10 +165,53 @@ TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAK
   EXPECT_EQ(rows, 3);  // header and two runs
 
   // The report's headline has the in-mill row beside the single impact's.
-  ASSERT_EQ(orchestrate("--case " + yaml + " --stage report --output " + dir.string(), dir / "report.log"), 0)
+  ASSERT_EQ(orchestrate("--case " + yaml + " --stage report --output " + dir.string(),
+                        dir / "report.log"),
+            0)
       << slurp(dir / "report.log");
-  EXPECT_NE(slurp(dir / "report/index.html").find("in the mill (2 lumps, strike and housing impacts), 2000 rpm"),
+  EXPECT_NE(slurp(dir / "report/index.html")
+                .find("in the mill (2 lumps, strike and housing impacts), 2000 rpm"),
             std::string::npos);
+}
+
+// With gas: still air of 1.2 kg/m3 over the tiny housing (a field where the
+// sample stage puts it); the run takes the drag and says so. One lump of the
+// two is chosen: the one of the median strike normal speed, lump 2 (41.9 m/s
+// against 35.7), the one the beater cannot reach.
+TEST(InMill, GasDragFromTheSampledField) {
+  const fs::path dir = scratch("in_mill_gas");
+  write_transport_impacts(dir);
+  mill::post::FlowField f;
+  const double h = 0.05;
+  f.origin = {-0.4, 0.0, -0.15};
+  f.spacing = {h, h, h};
+  f.dims = {17, 25, 7};
+  f.allocate(false);
+  for (size_t p = 0; p < f.mask.size(); ++p) {
+    f.mask[p] = 1;
+    f.rho[p] = 1.2;
+  }
+  f.rpm = 2000;
+  f.gas_model = "incompressible";
+  f.source = "synthetic: still air (test_in_mill_e2e)";
+  mill::post::write_flow_field(dir / "sample/rpm2000/field.h5", f);
+  std::string yaml = slurp(kData + "/tiny_in_mill.yaml");
+  const std::string from = "in_mill: {lumps: 2, duration: 8.0e-3, lead_time: 2.0e-3, gas: false}";
+  ASSERT_NE(yaml.find(from), std::string::npos);
+  yaml.replace(yaml.find(from), from.size(),
+               "in_mill: {lumps: 1, duration: 4.0e-3, lead_time: 2.0e-3, gas: true}");
+  spit(dir / "case.yaml", yaml);
+  ASSERT_EQ(orchestrate("--case " + (dir / "case.yaml").string() + " --stage breakage --output " +
+                            dir.string(),
+                        dir / "run.log"),
+            0)
+      << slurp(dir / "run.log");
+  const auto j = nlohmann::json::parse(slurp(dir / "breakage/jobs/rpm2000_mill_p2/in_mill.json"));
+  EXPECT_TRUE(j.at("gas").get<bool>());
+  EXPECT_EQ(j.at("bonds_broken_at_strike").get<long>(), 0) << j.dump(2);
+  EXPECT_NE(
+      slurp(dir / "breakage/jobs/rpm2000_mill_p2/run/liggghts.log").find("in_mill: gas drag from"),
+      std::string::npos);
 }
 
 }  // namespace
