@@ -214,4 +214,23 @@ TEST(InMill, GasDragFromTheSampledField) {
       std::string::npos);
 }
 
+// With gas but no sampled field the in-mill run fails and says what makes it.
+TEST(InMill, MissingFieldNamesFileCommandAndKey) {
+  const fs::path dir = scratch("in_mill_nofield");
+  write_transport_impacts(dir);
+  std::string yaml = slurp(kData + "/tiny_in_mill.yaml");
+  const std::string from = "gas: false}";
+  ASSERT_NE(yaml.find(from), std::string::npos);
+  yaml.replace(yaml.find(from), from.size(), "gas: true}");
+  spit(dir / "case.yaml", yaml);
+  const int st = orchestrate("--case " + (dir / "case.yaml").string() +
+                                 " --stage breakage --task 1 --output " + dir.string(),
+                             dir / "log");
+  EXPECT_NE(st, 0);
+  const std::string log = slurp(dir / "log");
+  EXPECT_NE(log.find("sample/rpm2000/field.h5"), std::string::npos) << log;
+  EXPECT_NE(log.find("--stage sample"), std::string::npos) << log;
+  EXPECT_NE(log.find("breakage.in_mill.gas: false"), std::string::npos) << log;
+}
+
 }  // namespace
