@@ -221,11 +221,13 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
                a_strike = in.at("strike_angle_deg").get<double>();
   const LumpRunResult a = analyse_lump_run(
       ctx, lr, {v_strike, std::clamp(a_strike, 0.0, 90.0), repeat}, res.seconds, label);
-  // Walls are impenetrable: an element outside the housing's sides passed
-  // through a wall between steps (the floor and roof have openings).
+  // Walls are impenetrable: an element beside the housing, between floor and
+  // roof, passed through a side wall between steps (elements that left
+  // through the openings in the floor or the roof fly on outside).
   const long through =
       std::count_if(a.snap.elements.begin(), a.snap.elements.end(), [&](const post::Element& e) {
-        return std::abs(e.x[0]) > 0.5 * g.width || std::abs(e.x[2]) > 0.5 * g.depth;
+        return e.x[1] >= 0 && e.x[1] <= g.height &&
+               (std::abs(e.x[0]) > 0.5 * g.width || std::abs(e.x[2]) > 0.5 * g.depth);
       });
   if (through > 0)
     throw std::runtime_error(
