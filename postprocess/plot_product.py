@@ -13,6 +13,11 @@ draws product_vs_rpm.png:
           these flatten, the rotor speed can be lowered for the same product
   right   the product's cumulative % passing against size [mm], log axis, per rpm
 
+Where an entry has an `in_mill` object (breakage.in_mill: bonded lumps run in
+the turning mill from their first flywheel strike, with the housing impacts
+that follow), its values are drawn on the same axes, dashed with hollow
+markers and labelled "in mill", beside the single-impact product.
+
 Usage: plot_product.py --product breakage/product.json --out breakage/plots
 """
 
@@ -51,6 +56,11 @@ def read_product(path):
                      f"{len(e['fraction_mass'])} fractions")
         if len(e["sieves_mm"]) != len(e["passing_percent"]):
             sys.exit(f"{path}: entry {i}: {len(e['sieves_mm'])} sieves for {len(e['passing_percent'])} passing values")
+        if "in_mill" in e:
+            missing = [k for k in ("fully_shredded_mass_fraction", "largest_piece_mass_fraction", "t10_percent",
+                                   "sieves_mm", "passing_percent", "p50_mm", "p80_mm") if k not in e["in_mill"]]
+            if missing:
+                sys.exit(f"{path}: entry {i}: in_mill lacks {', '.join(missing)}")
     return sorted(data, key=lambda e: e["rpm"])
 
 
@@ -64,13 +74,21 @@ def main(argv=None):
 
     rpm = np.array([e["rpm"] for e in data])
     fig, (ax0, ax1, ax2) = plt.subplots(1, 3, figsize=(14, 4.3))
+    colour = {}
     for key, label, style in (("p80_mm", "P80", "o-"), ("p50_mm", "P50", "s--")):
         ys = [e[key] if e[key] is not None else e["sieves_mm"][0] for e in data]
         line, = ax0.plot(rpm, ys, style, label=label)
+        colour[key] = line.get_color()
         below = [(r, y) for r, y, e in zip(rpm, ys, data) if e[key] is None]
         if below:
             ax0.plot([b[0] for b in below], [b[1] for b in below], "o", mfc="white", color=line.get_color(),
                      label=f"{label} finer than the finest sieve")
+    mill = [e for e in data if "in_mill" in e]
+    mill_rpm = np.array([e["rpm"] for e in mill])
+    for key, label, style in (("p80_mm", "P80 in mill", "o:"), ("p50_mm", "P50 in mill", "s:")):
+        if mill:
+            ys = [e["in_mill"][key] if e["in_mill"][key] is not None else e["in_mill"]["sieves_mm"][0] for e in mill]
+            ax0.plot(mill_rpm, ys, style, mfc="white", color=colour[key], label=label)
     ax0.set_xlabel("rotor speed [rpm]")
     ax0.set_ylabel("size [mm]")
     ax0.set_ylim(bottom=0)
@@ -81,19 +99,26 @@ def main(argv=None):
     for key, label, scale in (("fully_shredded_mass_fraction", "fully shredded mass", 100),
                               ("largest_piece_mass_fraction", "largest piece", 100),
                               ("t10_percent", "t10 (finer than D/10)", 1)):
-        ax1.plot(rpm, [scale * e[key] for e in data], "o-", label=label)
+        line, = ax1.plot(rpm, [scale * e[key] for e in data], "o-", label=label)
+        if mill:
+            ax1.plot(mill_rpm, [scale * e["in_mill"][key] for e in mill], "o:", mfc="white", color=line.get_color(),
+                     label=f"{label}, in mill")
     ax1.set_xlabel("rotor speed [rpm]")
     ax1.set_ylabel("% of the feed mass")
     ax1.set_ylim(-2, 102)
     for ax in (ax0, ax1):
         if len(rpm) == 1:
             ax.set_xlim(rpm[0] * 0.8, rpm[0] * 1.2)
-    ax1.set_title("One pass through the mill")
+    ax1.set_title("One pass: single impact" + (" and in mill" if mill else ""))
     ax1.legend(fontsize=8)
     ax1.grid(alpha=0.3)
 
     for e in data:
-        ax2.semilogx(e["sieves_mm"], e["passing_percent"], "o-", ms=3, label=f"{e['rpm']:g} rpm")
+        line, = ax2.semilogx(e["sieves_mm"], e["passing_percent"], "o-", ms=3, label=f"{e['rpm']:g} rpm")
+        if "in_mill" in e:
+            m = e["in_mill"]
+            ax2.semilogx(m["sieves_mm"], m["passing_percent"], "o:", ms=3, mfc="white", color=line.get_color(),
+                         label=f"{e['rpm']:g} rpm, in mill ({m.get('lumps', '?')} lumps)")
     ax2.axhline(80, color="k", ls=":", lw=0.8)
     ax2.set_xlabel("size [mm]")
     ax2.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:g}"))

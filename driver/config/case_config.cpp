@@ -74,6 +74,9 @@ std::string suggest(const Schema& s, const std::string& path) {
     // Also accept a right leaf under a wrong-looking parent (e.g. "rotor.rmp").
     const std::string cleaf = c.substr(c.rfind('.') == std::string::npos ? 0 : c.rfind('.') + 1);
     d = std::min(d, edit_distance(leaf, cleaf) + (c == path ? 0 : 1));
+    // A shortened key in the right section ("breakage.in_mill.lead").
+    const std::string parent = path.substr(0, path.size() - leaf.size()), cparent = c.substr(0, c.size() - cleaf.size());
+    if (!leaf.empty() && parent == cparent && cleaf.rfind(leaf, 0) == 0) d = std::min<size_t>(d, 1);
     if (d < best_d) {
       best_d = d;
       best = c;
@@ -447,6 +450,18 @@ void check_physics(const Document& d) {
     fail("gas.outlet_pressure_drop",
          fmt::format("expected less than gas.pressure ({:g} Pa): the outlet would be at or below vacuum, got {:g} Pa",
                      d.real("gas.pressure"), d.real("gas.outlet_pressure_drop")));
+
+  // In-mill breakage starts from stage 1's strikes and must outlast its lead.
+  if (d.integer("breakage.in_mill.lumps") > 0 && d.str("breakage.conditions") != "transport")
+    fail("breakage.in_mill.lumps",
+         fmt::format("in-mill breakage starts from stage 1's flywheel strikes; expected breakage.conditions: transport "
+                     "(got {}), or breakage.in_mill.lumps: 0, got {}",
+                     d.str("breakage.conditions"), d.integer("breakage.in_mill.lumps")));
+  if (d.real("breakage.in_mill.lead_time") >= d.real("breakage.in_mill.duration"))
+    fail("breakage.in_mill.lead_time",
+         fmt::format("expected shorter than breakage.in_mill.duration ({:g} s): the run would end before the strike, "
+                     "got {:g} s",
+                     d.real("breakage.in_mill.duration"), d.real("breakage.in_mill.lead_time")));
 
   // Breakage: a given time step must be well inside the simulated time.
   const double after = d.real("breakage.duration_after_contact"), bdt = d.real("breakage.timestep");

@@ -194,6 +194,23 @@ Schema make_case_schema() {
                 "Critical velocity: largest piece mass fraction falls below this"), 0, true, 1, true),
       at_least(key("breakage.velocity_bins", T::Int, "", "5", "transport conditions: bins of impact normal speed"), 1),
       key("breakage.include_wall_impacts", T::Bool, "", "false", "transport conditions: also wall impacts"),
+      at_least(key("breakage.in_mill.lumps", T::Int, "", "0",
+                   "In-mill breakage (needs conditions: transport): lumps per rotor speed run as bonded lumps in the "
+                   "turning mill from stage 1's first flywheel strikes, chosen spread over the strike speeds; 0 = none"),
+               0),
+      positive(key("breakage.in_mill.duration", T::Real, "s", "0.02",
+                   "In-mill breakage: simulated time of each run, from lead_time before the strike (long enough for "
+                   "the fragments' first housing impacts)")),
+      positive(key("breakage.in_mill.lead_time", T::Real, "s", "2e-3",
+                   "In-mill breakage: a run starts this long before the lump's first flywheel strike (its state "
+                   "backed off ballistically from the strike)")),
+      key("breakage.in_mill.gas", T::Bool, "", "true",
+          "In-mill breakage: gas drag on each element from the sampled field (sample stage); false = no gas"),
+      at_least(key("breakage.in_mill.neighbour_bins", T::Int, "", "4000000",
+                   "In-mill breakage: most neighbour bins over the simulation box, which holds the whole mill "
+                   "(LIGGGHTS clears every bin at each list build); the bins start at the larger of 4 mean element "
+                   "radii and (box volume / this)^(1/3) and grow as the fragments spread"),
+               1000),
 
       // --- calibration (virtual lab tests) ---
       at_least(key("calibrate.n_elements", T::Int, "", "1500", "Elements in a lab specimen"), 20),

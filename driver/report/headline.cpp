@@ -173,6 +173,17 @@ json headline_json(const fs::path& run, Problems* problems) {
             {"finest_sieve_mm", pick(p, "sieves_mm").is_array() && !pick(p, "sieves_mm").empty()
                                     ? pick(p, "sieves_mm")[0]
                                     : json(nullptr)}};
+  // In-mill breakage (breakage.in_mill): the product of lumps run in the mill.
+  if (prod.is_array())
+    for (const auto& p : prod)
+      if (num(pick(p, "rpm")) && pick(p, "in_mill").is_object()) {
+        const json& m = p.at("in_mill");
+        json x;
+        for (const char* k : {"lumps", "fully_shredded_mass_fraction", "largest_piece_mass_fraction", "t10_percent",
+                              "t10_resolved", "bonds_broken_at_strike_fraction", "p50_mm", "p80_mm"})
+          x[k] = pick(m, k);
+        h["product"][fmt::format("rpm{:g}", d(pick(p, "rpm")))]["in_mill"] = x;
+      }
   return h;
 }
 
@@ -365,6 +376,23 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
     if (num(pick(p, "largest_piece_mass_fraction")))
       add(4, "largest piece" + at,
           percent(d(p.at("largest_piece_mass_fraction"))) + " of a lump (mean over the impact conditions)", false);
+    // Beside it, the lumps run in the mill: the strike and what follows.
+    const json m = pick(p, "in_mill");
+    if (m.is_object() && num(pick(m, "fully_shredded_mass_fraction"))) {
+      std::string v = fmt::format("fully shredded {} of the mass, largest piece {}, t10 {:.0f}%{}",
+                                  percent(d(m.at("fully_shredded_mass_fraction"))),
+                                  num(pick(m, "largest_piece_mass_fraction")) ? percent(d(m.at("largest_piece_mass_fraction")))
+                                                                               : std::string("?"),
+                                  num(pick(m, "t10_percent")) ? d(m.at("t10_percent")) : 0.0,
+                                  pick(m, "t10_resolved").is_boolean() && !m.at("t10_resolved").get<bool>()
+                                      ? " (unresolved: elements too coarse)"
+                                      : "");
+      if (num(pick(m, "bonds_broken_at_strike_fraction")))
+        v += fmt::format("; {} of the broken bonds broke at the beater strike",
+                         percent(d(m.at("bonds_broken_at_strike_fraction"))));
+      const int lumps = num(pick(m, "lumps")) ? static_cast<int>(d(m.at("lumps"))) : 0;
+      add(4, fmt::format("in the mill ({} lump{}, strike and housing impacts){}", lumps, lumps == 1 ? "" : "s", at), v);
+    }
   }
   return rows;
 }

@@ -2,22 +2,12 @@
 #include "stages/breakage_stage.h"
 
 #include <fmt/format.h>
-#include <vtkCellArray.h>
-#include <vtkDoubleArray.h>
-#include <vtkIntArray.h>
-#include <vtkNew.h>
-#include <vtkPointData.h>
-#include <vtkPoints.h>
-#include <vtkPolyData.h>
-#include <vtkXMLPolyDataWriter.h>
 
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <random>
 #include <sstream>
-#include <unordered_map>
 
 #include "engine/liggghts.h"
 #include "jobs/job_store.h"
@@ -29,7 +19,9 @@
 #include "postprocess/lammps_dump.h"
 #include "progress.h"
 #include "stages/breakage_summaries.h"
+#include "stages/in_mill_runs.h"
 #include "stages/lump_builder.h"
+#include "stages/lump_run.h"
 #include "stages/material.h"
 #include "stages/stage_util.h"
 
@@ -42,75 +34,6 @@ namespace {
 // Most an element may move in one impact step, as a share of the smallest
 // element radius.
 constexpr double kStepMove = 0.1;
-
-nlohmann::json bond_json(const BondParams& b) {
-  return {{"modulus", b.modulus},   {"stiffness_ratio", b.stiffness_ratio},       {"tensile", b.tensile},
-          {"cohesion", b.cohesion}, {"friction_angle_deg", b.friction_angle_deg}, {"radius_multiplier", b.radius_multiplier},
-          {"moment_factor", b.moment_factor}};
-}
-
-// A uniformly random rotation (Shoemake 1992, "Uniform random rotations",
-// Graphics Gems III) as axis and angle in degrees, from a seed.
-std::array<double, 4> random_rotation(unsigned long long seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  const double u1 = u(rng), u2 = u(rng), u3 = u(rng);
-  const double a = std::sqrt(1 - u1), b = std::sqrt(u1);
-  const double q[4] = {b * std::cos(2 * M_PI * u3), a * std::sin(2 * M_PI * u2), a * std::cos(2 * M_PI * u2),
-                       b * std::sin(2 * M_PI * u3)};  // w, x, y, z
-  const double w = std::min(1.0, std::abs(q[0]));
-  const double s = q[0] < 0 ? -1.0 : 1.0;
-  const double angle = 2 * std::acos(w) * 180.0 / M_PI;
-  const double n = std::sqrt(q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  if (n < 1e-12) return {0, 0, 1, 0};
-  return {s * q[1] / n, s * q[2] / n, s * q[3] / n, angle};
-}
-
-// Elements as points for ParaView, coloured by fragment (0 = largest piece).
-void write_fragments_vtp(const fs::path& file, const post::DumpSnapshot& snap, const post::ImpactResult& r) {
-  std::unordered_map<long long, int> frag_of;
-  for (size_t f = 0; f < r.fragments.size(); ++f)
-    for (long long id : r.fragments[f].ids) frag_of[id] = static_cast<int>(f);
-  vtkNew<vtkPoints> pts;
-  vtkNew<vtkIntArray> frag, size, ids;
-  vtkNew<vtkDoubleArray> radius, vel;
-  frag->SetName("fragment");
-  size->SetName("fragment_elements");
-  ids->SetName("id");
-  radius->SetName("radius");
-  vel->SetName("velocity");
-  vel->SetNumberOfComponents(3);
-  vtkNew<vtkCellArray> verts;
-  for (const auto& e : snap.elements) {
-    const vtkIdType pid = pts->InsertNextPoint(e.x[0], e.x[1], e.x[2]);
-    verts->InsertNextCell(1, &pid);
-    const int f = frag_of.count(e.id) ? frag_of[e.id] : -1;
-    frag->InsertNextValue(f);
-    size->InsertNextValue(f >= 0 ? static_cast<int>(r.fragments[f].n_elements()) : 0);
-    ids->InsertNextValue(static_cast<int>(e.id));
-    radius->InsertNextValue(e.radius);
-    vel->InsertNextTuple3(e.v[0], e.v[1], e.v[2]);
-  }
-  vtkNew<vtkPolyData> pd;
-  pd->SetPoints(pts);
-  pd->SetVerts(verts);
-  for (vtkDataArray* a : std::initializer_list<vtkDataArray*>{frag, size, ids, radius, vel}) pd->GetPointData()->AddArray(a);
-  pd->GetPointData()->SetActiveScalars("fragment");
-  const fs::path tmp = file.string() + ".tmp.vtp";
-  vtkNew<vtkXMLPolyDataWriter> w;
-  w->SetFileName(tmp.c_str());
-  w->SetInputData(pd);
-  w->SetDataModeToBinary();
-  if (w->Write() != 1) throw std::runtime_error("cannot write " + tmp.string());
-  fs::rename(tmp, file);
-}
-
-long read_long(const fs::path& f) {
-  std::ifstream in(f);
-  double v = -1;
-  if (!(in >> v)) throw std::runtime_error(f.string() + ": no number (the deck did not reach its first run)");
-  return std::lround(v);
-}
 
 // Inputs every impact of the case shares.
 nlohmann::json impact_base_inputs(const StageContext& ctx) {
@@ -135,22 +58,7 @@ nlohmann::json impact_inputs(const StageContext& ctx, double velocity, double an
   return in;
 }
 
-std::string damaged_impact_outputs(const fs::path& dir) {
-  if (auto r = jobs::first_problem({jobs::check_file(dir / "summary.csv"), jobs::check_file(dir / "fractions.csv"),
-                                    jobs::check_json(dir / "result.json"), jobs::check_hdf5(dir / "impact.h5"),
-                                    jobs::check_file(dir / "fragments.vtp")});
-      !r.empty())
-    return r;
-  try {
-    const auto rows = post::ReadSummaryCsv((dir / "summary.csv").string());
-    if (rows.size() != 1) return fmt::format("{}: {} rows, expected 1", (dir / "summary.csv").string(), rows.size());
-    if (post::ReadFractionsCsv((dir / "fractions.csv").string()).empty())
-      return (dir / "fractions.csv").string() + ": no rows";
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string damaged_impact_outputs(const fs::path& dir) { return damaged_lump_outputs(dir); }
 
 std::string impact_line(const nlohmann::json& r) {
   auto num = [&](const char* k) { return r.contains(k) && r[k].is_number() ? r[k].get<double>() : NAN; };
@@ -164,11 +72,17 @@ std::string impact_line(const nlohmann::json& r) {
 }
 
 std::string BreakageStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
-  return damaged_impact_outputs(jobs::JobStore(ctx.stage_dir).job_dir(job.label));
+  const fs::path dir = jobs::JobStore(ctx.stage_dir).job_dir(job.label);
+  return is_in_mill_job(job) ? damaged_in_mill_outputs(dir) : damaged_impact_outputs(dir);
 }
 
 std::vector<std::string> BreakageStage::reads(const config::CaseConfig& cfg) const {
-  if (cfg.doc.str("breakage.conditions") == "transport") return {"transport", "calibrate"};
+  if (cfg.doc.str("breakage.conditions") == "transport") {
+    // In-mill runs with gas drag read the sampled field too.
+    if (cfg.doc.integer("breakage.in_mill.lumps") > 0 && cfg.doc.boolean("breakage.in_mill.gas"))
+      return {"sample", "transport", "calibrate"};
+    return {"transport", "calibrate"};
+  }
   return {"calibrate"};
 }
 
@@ -211,6 +125,7 @@ Plan BreakageStage::plan(const StageContext& ctx) const {
                                         rpm_label(rpm), c.bin, 100 * c.weight, c.normal_low_m_s, c.normal_high_m_s, v, a,
                                         r)});
         }
+      plan_in_mill(ctx, rpm, p);
     }
     return p;
   }
@@ -231,21 +146,18 @@ Plan BreakageStage::plan(const StageContext& ctx) const {
 std::string run_impact(StageContext& ctx, double velocity, double angle, int repeat, const fs::path& out_dir,
                        const std::string& label) {
   const auto& d = ctx.cfg.doc;
-  const LumpSpec spec = lump_spec(ctx.cfg);
-  const int packing = static_cast<int>(repeat % d.integer("lump.n_packings"));
-  const LumpInfo lump = ensure_lump(ctx, spec, packing, label);
-  const BondParams bond = bond_params_for(ctx.cfg, ctx.run_dir);
+  const LumpRun lr = prepare_lump_run(ctx, repeat, out_dir, label);
+  const LumpInfo& lump = lr.lump;
 
   // Start just short of contact: a gap of a tenth of an element radius.
   const double gap = 0.1 * lump.mean_radius;
   const double t_contact = gap / (velocity * std::sin(angle * M_PI / 180.0));
   const double t_end = t_contact + d.real("breakage.duration_after_contact");
-  const auto rot = random_rotation(1469598103ULL * static_cast<unsigned long long>(d.integer("lump.seed")) + 7919ULL * repeat);
 
   // The time step bounds how far an element moves per step: at most a tenth
   // of the smallest element radius (half the neighbour skin is 0.15 of the
   // mean radius), or the lump passes through the surface between two steps.
-  const double r_min = (1.0 - d.real("lump.radius_spread")) * lump.mean_radius;
+  const double r_min = lr.r_min;
   const double dt_speed = kStepMove * r_min / velocity;
   const double dt_given = d.real("breakage.timestep");
   if (dt_given > dt_speed)
@@ -254,21 +166,14 @@ std::string run_impact(StageContext& ctx, double velocity, double angle, int rep
         "({:.3g} m); expected breakage.timestep <= {:.3g} s, or 0 (automatic)",
         d.where("breakage.timestep"), velocity, velocity * dt_given, dt_given, kStepMove, r_min, dt_speed));
 
-  const fs::path work = out_dir / "run";
-  fs::remove_all(work);
   engine::DeckRun run;
   run.deck = ctx.cfg.project_dir / "liggghts_inputs" / "impact.in.tmpl";
-  run.workdir = work;
+  run.workdir = lr.work;
   run.np = ctx.opts.np;
   run.job = "breakage/" + label;
-  run.vars = {{"lump_file", fs::absolute(lump.data).string()},
-              {"velocity", num(velocity)},
+  run.vars = {{"velocity", num(velocity)},
               {"angle", num(angle)},
               {"z_plane", num(-(lump.outer_radius + gap))},
-              {"rot_x", num(rot[0])},
-              {"rot_y", num(rot[1])},
-              {"rot_z", num(rot[2])},
-              {"rot_angle", num(rot[3])},
               {"t_end", num(t_end)},
               {"t_contact", num(t_contact)},
               {"quiet_time", num(d.real("breakage.quiet_time"))},
@@ -276,88 +181,44 @@ std::string run_impact(StageContext& ctx, double velocity, double angle, int rep
               {"dt_speed", num(dt_speed)},
               {"skin", num(0.3 * lump.mean_radius)},
               {"binsize", num(4.0 * lump.mean_radius)},
-              {"dump_interval", num(d.real("breakage.dump_interval"))},
-              {"bond_gap", num(d.real("lump.bond_gap"))},
-              {"max_bonds", std::to_string(d.integer("lump.max_bonds"))}};
-  for (const auto& kv : material_vars(ctx.cfg.ore, bond, ctx.cfg.doc)) run.vars.push_back(kv);
+              {"dump_interval", num(d.real("breakage.dump_interval"))}};
+  for (const auto& kv : lump_deck_vars(ctx, lr)) run.vars.push_back(kv);
   const engine::Result res = engine::run_deck(ctx.runner, run, ctx.progress, label);
 
   // Fragment analysis of the final state.
-  post::ImpactSpec is;
-  is.conditions = {velocity, angle, repeat};
-  is.initial_bonds = read_long(work / "bonds_initial.txt");
-  is.lump_diameter_m = 2 * lump.outer_radius;
-  is.density_kg_m3 = ctx.cfg.ore.real("density");
-  is.fraction_edges = d.reals("breakage.size_fraction_edges");
-  is.wall_seconds = res.seconds;
-  if (is.initial_bonds != lump.bonds)
-    ctx.progress.warn(fmt::format("{}: {} bonds at impact but {} when the lump was built (same rule): check lump.bond_gap",
-                                  label, is.initial_bonds, lump.bonds));
-  const post::DumpSnapshot snap = post::ReadDumpLastSnapshot((work / "final.dump").string(), is.density_kg_m3);
-  if (static_cast<long>(snap.elements.size()) != lump.elements)
-    throw std::runtime_error(fmt::format("{}: {} elements in the final state, {} in the lump: elements were lost", label,
-                                         snap.elements.size(), lump.elements));
+  const LumpRunResult a = analyse_lump_run(ctx, lr, {velocity, angle, repeat}, res.seconds, label);
   // The surface is impenetrable: an element centre behind it means the run
   // stepped through the contact (the result would read as an intact bounce).
   const double z_plane = -(lump.outer_radius + gap);
-  const long behind = std::count_if(snap.elements.begin(), snap.elements.end(),
+  const long behind = std::count_if(a.snap.elements.begin(), a.snap.elements.end(),
                                     [&](const post::Element& e) { return e.x[2] < z_plane; });
   if (behind > 0)
     throw std::runtime_error(fmt::format(
         "{}: {} of {} elements ended behind the impact surface: the lump passed through it between time steps, the run "
         "is invalid (speed {:g} m/s, step bound {:.3g} s); log: {}",
-        label, behind, snap.elements.size(), velocity, dt_speed, (work / "liggghts.log").string()));
-  const auto bonds = post::ReadIntactBonds((work / "bonds_final.txt").string());
-  const post::ImpactResult r = post::AnalyseImpact(snap.elements, bonds, is, (work / "bonds_final.txt").string());
-  for (const auto& w : r.warnings) ctx.progress.warn(label + ": " + w);
+        label, behind, a.snap.elements.size(), velocity, dt_speed, (lr.work / "liggghts.log").string()));
 
-  // Outputs, each complete or absent (temporary name, then rename).
-  for (const char* f : {"summary.csv", "fractions.csv"}) fs::remove(out_dir / f);
-  const fs::path stmp = out_dir / "summary.csv.part", ftmp = out_dir / "fractions.csv.part";
-  fs::remove(stmp);
-  fs::remove(ftmp);
-  post::AppendSummaryCsv(stmp.string(), r.summary);
-  post::AppendFractionsCsv(ftmp.string(), r);
-  post::WriteBreakageH5((out_dir / "impact.h5").string(), {r});
-  write_fragments_vtp(out_dir / "fragments.vtp", snap, r);
-  const auto& s = r.summary;
-  nlohmann::json j = {{"velocity_m_s", velocity},
-                      {"angle_deg", angle},
-                      {"repeat", repeat},
-                      {"lump", {{"label", lump.label},
-                                {"elements", lump.elements},
-                                {"outer_diameter_m", 2 * lump.outer_radius},
-                                {"mean_element_radius_m", lump.mean_radius},
-                                {"coordination", lump.coordination}}},
-                      {"bond_parameters", bond_json(bond)},
-                      {"bond_parameters_origin", bond.origin},
-                      {"n_pieces", s.n_pieces},
-                      {"n_single", s.n_single},
-                      {"n_multi", s.n_multi},
-                      {"largest_mass_fraction", s.largest_mass_fraction},
-                      {"single_mass_fraction", s.single_mass_fraction},
-                      {"broken_bond_fraction", s.broken_bond_fraction},
-                      {"specific_energy_J_kg", s.specific_energy_J_kg},
-                      {"specific_energy_kWh_t", s.specific_energy_kWh_t},
-                      {"t10_percent", s.t10_percent},
-                      {"t10_resolved", s.t10_resolved},
-                      {"warnings", r.warnings},
-                      {"wall_seconds", res.seconds}};
-  jobs::atomic_write(out_dir / "result.json", j.dump(2) + "\n");
-  fs::rename(stmp, out_dir / "summary.csv");
-  fs::rename(ftmp, out_dir / "fractions.csv");
-  // The raw run stays for inspection (dumps for ParaView, logs); it is small
-  // next to the VTK dumps a user asks for.
+  // Outputs, each complete or absent. The raw run stays for inspection
+  // (dumps for ParaView, logs); it is small next to the VTK dumps a user asks for.
+  const nlohmann::json j = lump_result_json(lr, a.result, res.seconds);
+  write_lump_outputs(out_dir, a, j);
   return impact_line(j);
 }
 
 void BreakageStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& job_dir) {
+  if (is_in_mill_job(job)) {
+    ctx.progress.info("[breakage] " + job.label + ": " + run_in_mill(ctx, job, job_dir));
+    return;
+  }
   const std::string line = run_impact(ctx, job.inputs.at("velocity").get<double>(), job.inputs.at("angle").get<double>(),
                                       job.inputs.at("repeat").get<int>(), job_dir, job.label);
   ctx.progress.info("[breakage] " + job.label + ": " + line);
 }
 
-void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) {
+void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& all_jobs) {
+  // The single impacts make the sweep's results; the in-mill runs their own.
+  std::vector<JobSpec> jobs, in_mill;
+  for (const auto& j : all_jobs) (is_in_mill_job(j) ? in_mill : jobs).push_back(j);
   if (jobs.empty()) return;
   const fs::path dir = ctx.stage_dir;
   const jobs::JobStore store(dir);
@@ -430,13 +291,15 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& jobs
   c.log = dir / "plots.log";
   c.job = "breakage/plots";
   ctx.runner.run(c);
-  if (ctx.cfg.doc.str("breakage.conditions") == "transport") write_mill_product(ctx, jobs);
+  if (ctx.cfg.doc.str("breakage.conditions") == "transport")
+    write_mill_product(ctx, jobs, write_in_mill_results(ctx, in_mill));
   ctx.progress.info(fmt::format(
       "[breakage] results: {}/summary.csv, fractions.csv, size_distributions.csv, jk_fit.json, breakage.h5, plots/*.png",
       dir.string()));
 }
 
-void BreakageStage::write_mill_product(StageContext& ctx, const std::vector<JobSpec>& jobs) {
+void BreakageStage::write_mill_product(StageContext& ctx, const std::vector<JobSpec>& jobs,
+                                       const std::map<double, nlohmann::json>& in_mill) {
   // Per rotor speed: average each bin over its repeats, weight bins by their
   // share of impacts (postprocess/impact_conditions.h).
   const fs::path dir = ctx.stage_dir;
@@ -494,6 +357,7 @@ void BreakageStage::write_mill_product(StageContext& ctx, const std::vector<JobS
                         {"t10_percent", prod.t10_percent},
                         {"lump_diameter_mm", d_mm}};
     e.update(pass);
+    if (auto it = in_mill.find(rpm); it != in_mill.end()) e["in_mill"] = it->second;
     out.push_back(e);
     const auto mm = [&](const char* k) {
       return pass[k].is_number() ? fmt::format("{:.3g} mm", pass[k].get<double>())

@@ -4,6 +4,8 @@
 // velocity.
 #pragma once
 
+#include <map>
+
 #include "stages/stage.h"
 
 namespace mill {
@@ -26,7 +28,10 @@ class BreakageStage : public Stage {
  private:
   // breakage/product.csv and product.json: the mill product per rotor speed
   // when the conditions came from the transport stage.
-  void write_mill_product(StageContext& ctx, const std::vector<JobSpec>& jobs);
+  // With in-mill runs, each rotor speed's entry also holds their product
+  // (`in_mill`, from write_in_mill_results).
+  void write_mill_product(StageContext& ctx, const std::vector<JobSpec>& jobs,
+                          const std::map<double, nlohmann::json>& in_mill);
 };
 
 // The canonical inputs of one impact (the job id is their hash): case keys of

@@ -124,3 +124,19 @@ TEST(Headline, LumpsLeavingTheBeatersAndTheirNextHousingImpact) {
 }
 
 }  // namespace
+
+namespace {
+
+// In-mill breakage: a row beside the single-impact product, in words.
+TEST(Headline, InMillProductBesideTheSingleImpacts) {
+  const json h = json::parse(R"({"product": {"rpm2000": {"p80_mm": 8.14, "p50_mm": 3.21,
+      "fully_shredded_mass_fraction": 0.45,
+      "in_mill": {"lumps": 1, "fully_shredded_mass_fraction": 0.62, "largest_piece_mass_fraction": 0.08,
+                  "t10_percent": 71.4, "t10_resolved": true, "bonds_broken_at_strike_fraction": 0.83}}}})");
+  const auto rows = headline_rows(h);
+  EXPECT_EQ(value_of(rows, "in the mill (1 lump, strike and housing impacts), 2000 rpm"),
+            "fully shredded 62% of the mass, largest piece 8%, t10 71%; 83% of the broken bonds broke at the beater "
+            "strike");
+}
+
+}  // namespace

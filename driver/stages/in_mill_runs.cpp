@@ -1,0 +1,415 @@
+// In-mill breakage jobs: start states, the run, the record, the product.
+#include "stages/in_mill_runs.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include "engine/liggghts.h"
+#include "geometry/mill_geometry.h"
+#include "jobs/job_store.h"
+#include "jobs/output_checks.h"
+#include "postprocess/in_mill.h"
+#include "postprocess/lammps_dump.h"
+#include "progress.h"
+#include "stages/breakage_summaries.h"
+#include "stages/lump_run.h"
+#include "stages/stage_util.h"
+
+namespace mill {
+namespace fs = std::filesystem;
+using engine::num;
+
+namespace {
+
+using post::kPi;
+constexpr double kG = 9.81;
+// 1: first version (issue 14).
+// 2: hub of 24 facets, skin of one mean element radius.
+constexpr int kInMillDeckVersion = 2;
+// Facets of the flywheel's hub circle in the in-mill runs (see run_in_mill).
+constexpr int kHubFacets = 24;
+// Neighbour skin in mean element radii: the turning flywheel forces a list
+// build whenever its tips have moved half the skin (every ~25 steps at 0.3
+// radii and 105 m/s); one radius builds 3 x less often (bench/README.md).
+constexpr double kSkinRadii = 1.0;
+// Most an element may move in one step, as a share of the smallest element
+// radius (as for the single impacts).
+constexpr double kStepMove = 0.1;
+
+double omega_of(double rpm) { return rpm * 2 * kPi / 60.0; }
+
+std::array<double, 3> vec3(const nlohmann::json& j) {
+  return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
+}
+
+// The columns of in_mill.csv, in order.
+const std::vector<std::string>& csv_columns() {
+  static const std::vector<std::string> c = {"rpm",
+                                             "label",
+                                             "particle_id",
+                                             "strike_time_s",
+                                             "strike_speed_m_s",
+                                             "strike_angle_deg",
+                                             "n_elements",
+                                             "n_pieces",
+                                             "n_single",
+                                             "largest_mass_fraction",
+                                             "single_mass_fraction",
+                                             "t10_percent",
+                                             "t10_resolved",
+                                             "broken_bond_fraction",
+                                             "bonds_broken_at_strike",
+                                             "bonds_broken_later",
+                                             "flywheel_contacts",
+                                             "housing_contacts",
+                                             "housing_normal_speed_mean_m_s",
+                                             "mass_rotor",
+                                             "mass_housing",
+                                             "mass_outlet",
+                                             "mass_inlet",
+                                             "wall_seconds"};
+  return c;
+}
+
+}  // namespace
+
+bool is_in_mill_job(const JobSpec& job) { return job.inputs.value("mode", "") == "in_mill"; }
+
+void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan) {
+  const auto& d = ctx.cfg.doc;
+  const long k = d.integer("breakage.in_mill.lumps");
+  if (k <= 0) return;
+  const fs::path f = ctx.run_dir / "transport" / rpm_label(rpm) / "impacts.csv";
+  const geometry::MillGeometry g = geometry::MillGeometry::from_config(d);
+  post::RotorMotion rotor;
+  rotor.omega_rad_s = omega_of(rpm);
+  rotor.origin = {g.axis_x, g.axis_height, 0.0};
+  rotor.gravity_m_s2 = kG;
+  std::vector<post::StrikeStart> starts;
+  try {
+    starts = post::SelectStrikeStarts(post::ReadImpactsCsv(f.string()), static_cast<int>(k),
+                                      d.real("breakage.in_mill.lead_time"), rotor);
+  } catch (const post::PostError& e) {
+    throw MissingInput(fmt::format("in-mill breakage at {} (breakage.in_mill.lumps {}): {}: {}",
+                                   rpm_label(rpm), k, f.string(), e.what()));
+  }
+  const bool gas = d.boolean("breakage.in_mill.gas");
+  std::vector<std::string> keys = {"lump.",
+                                   "mill.",
+                                   "breakage.timestep",
+                                   "breakage.dump_interval",
+                                   "breakage.in_mill.duration",
+                                   "breakage.in_mill.lead_time",
+                                   "breakage.in_mill.gas",
+                                   "breakage.in_mill.neighbour_bins"};
+  if (gas)
+    for (const char* p : {"gas.", "flow.", "sample."}) keys.push_back(p);
+  nlohmann::json base = case_keys(d, keys);
+  base["ore"] = ore_keys(ctx.cfg.ore);
+  base["bond"] = bond_json(bond_params_for(ctx.cfg, ctx.run_dir));
+  base["in_mill_deck_version"] = kInMillDeckVersion;
+  base["mode"] = "in_mill";
+  base["rpm"] = rpm;
+  for (size_t i = 0; i < starts.size(); ++i) {
+    const auto& s = starts[i];
+    nlohmann::json in = base;
+    in["repeat"] = static_cast<int>(i);
+    in["particle_id"] = s.particle_id;
+    in["strike_time_s"] = s.strike_time_s;
+    in["start_time_s"] = s.start_time_s;
+    in["position"] = s.position;
+    in["velocity"] = s.velocity;
+    in["rotor_angle_rad"] = s.rotor_angle_rad;
+    in["strike_speed_m_s"] = s.strike_speed_m_s;
+    in["strike_normal_speed_m_s"] = s.strike_normal_speed_m_s;
+    in["strike_angle_deg"] = s.strike_angle_deg;
+    plan.jobs.push_back(
+        {fmt::format("{}_mill_p{}", rpm_label(rpm), s.particle_id), in,
+         fmt::format(
+             "{} in-mill: lump {} of stage 1 from {:g} ms before its flywheel strike at {:.1f} "
+             "m/s ({:.0f} deg), {:g} ms in the mill",
+             rpm_label(rpm), s.particle_id, 1e3 * d.real("breakage.in_mill.lead_time"),
+             s.strike_speed_m_s, s.strike_angle_deg, 1e3 * d.real("breakage.in_mill.duration"))});
+  }
+}
+
+std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& out_dir) {
+  const auto& d = ctx.cfg.doc;
+  const auto& in = job.inputs;
+  const std::string label = job.label;
+  const double rpm = in.at("rpm").get<double>(), omega = omega_of(rpm);
+  const int repeat = in.at("repeat").get<int>();
+  const bool gas = d.boolean("breakage.in_mill.gas");
+  const fs::path field_file = ctx.run_dir / "sample" / rpm_label(rpm) / "field.h5";
+  if (gas && !fs::exists(field_file))
+    throw MissingInput(fmt::format(
+        "in-mill breakage ({}) needs {} (the sampled gas field at {:g} rpm, breakage.in_mill.gas: "
+        "true); make it with "
+        "`orchestrate --case {} --stage sample --output {}`, or set breakage.in_mill.gas: false",
+        label, field_file.string(), rpm, d.file(), ctx.run_dir.string()));
+
+  const LumpRun lr = prepare_lump_run(ctx, repeat, out_dir, label);
+  // The mill, its flywheel turned to its angle at the start.
+  geometry::MillGeometry g = geometry::MillGeometry::from_config(d);
+  g.rotor_angle = in.at("rotor_angle_rad").get<double>();
+  // The hub circle drawn with kHubFacets instead of 96 facets: the impact
+  // recorder tests every element against every facet at each step (816
+  // facets took half the run time); the polygon departs from the circle by
+  // r (1 - cos(pi / kHubFacets)), 1.3 mm on a 0.3 m hub.
+  g.arc_segments = kHubFacets;
+  fs::create_directories(lr.work);
+  const geometry::StlSet stl = geometry::write_stl_set(g, lr.work / "stl");
+
+  // Neighbour bins: the box holds the whole mill, so the bins start large
+  // enough that it holds at most neighbour_bins of them.
+  const double margin = 0.05;
+  const double box_volume =
+      (g.width + 2 * margin) * (g.height + 2 * margin) * (g.depth + 2 * margin);
+  const double bin0 = std::max(
+      4.0 * lr.lump.mean_radius,
+      std::cbrt(box_volume / static_cast<double>(d.integer("breakage.in_mill.neighbour_bins"))));
+  // The fastest an element is expected to move: its start speed plus twice
+  // the rim speed (flung by a beater, elastic at most).
+  const auto x0 = vec3(in.at("position")), v0 = vec3(in.at("velocity"));
+  const double v_max = std::hypot(v0[0], v0[1], v0[2]) + 2 * omega * g.tip_radius();
+  const double dt_speed = kStepMove * lr.r_min / v_max;
+  const double dt_given = d.real("breakage.timestep");
+  if (dt_given > dt_speed)
+    throw std::runtime_error(
+        fmt::format("{}: at up to {:.0f} m/s (start speed plus twice the rim speed) an element "
+                    "moves {:.3g} m per step of {:g} s, "
+                    "more than {:g} of the smallest element radius ({:.3g} m); expected "
+                    "breakage.timestep <= {:.3g} s, or 0 "
+                    "(automatic)",
+                    d.where("breakage.timestep"), v_max, v_max * dt_given, dt_given, kStepMove,
+                    lr.r_min, dt_speed));
+
+  engine::DeckRun run;
+  run.deck = ctx.cfg.project_dir / "liggghts_inputs" / "in_mill.in.tmpl";
+  run.workdir = lr.work;
+  run.np = ctx.opts.np;
+  run.job = "breakage/" + label;
+  run.vars = {{"housing_stl", fs::absolute(stl.housing).string()},
+              {"flywheel_stl", fs::absolute(stl.flywheel).string()},
+              {"axis_x", num(g.axis_x)},
+              {"axis_y", num(g.axis_height)},
+              {"omega", num(omega)},
+              {"g", num(kG)},
+              {"x0", num(x0[0])},
+              {"y0", num(x0[1])},
+              {"z0", num(x0[2])},
+              {"vx0", num(v0[0])},
+              {"vy0", num(v0[1])},
+              {"vz0", num(v0[2])},
+              {"gas", gas ? "1" : "0"},
+              {"field_file", gas ? fs::absolute(field_file).string() : std::string("none")},
+              {"viscosity", num(d.real("gas.viscosity"))},
+              {"t_end", num(d.real("breakage.in_mill.duration"))},
+              {"dt", num(dt_given)},
+              {"dt_speed", num(dt_speed)},
+              {"skin", num(kSkinRadii * lr.lump.mean_radius)},
+              {"binsize", num(bin0)},
+              {"dump_interval", num(d.real("breakage.dump_interval"))}};
+  for (const auto& kv : lump_deck_vars(ctx, lr)) run.vars.push_back(kv);
+  const engine::Result res = engine::run_deck(ctx.runner, run, ctx.progress, label);
+
+  // Fragments, judged at the strike's relative speed (its specific energy).
+  const double v_strike = in.at("strike_speed_m_s").get<double>(),
+               a_strike = in.at("strike_angle_deg").get<double>();
+  const LumpRunResult a = analyse_lump_run(
+      ctx, lr, {v_strike, std::clamp(a_strike, 0.0, 90.0), repeat}, res.seconds, label);
+  // Walls are impenetrable: an element beside the housing, between floor and
+  // roof, passed through a side wall between steps (elements that left
+  // through the openings in the floor or the roof fly on outside).
+  const long through =
+      std::count_if(a.snap.elements.begin(), a.snap.elements.end(), [&](const post::Element& e) {
+        return e.x[1] >= 0 && e.x[1] <= g.height &&
+               (std::abs(e.x[0]) > 0.5 * g.width || std::abs(e.x[2]) > 0.5 * g.depth);
+      });
+  if (through > 0)
+    throw std::runtime_error(
+        fmt::format("{}: {} of {} elements ended outside the housing's side walls: they passed "
+                    "through a wall between steps, the run is invalid; log: {}",
+                    label, through, a.snap.elements.size(), (lr.work / "liggghts.log").string()));
+
+  // The record: contacts, bonds broken at the strike and later, mass places.
+  const auto contacts = post::ReadImpactsCsv((lr.work / "impacts.csv").string());
+  const auto split =
+      post::SplitBreaks(post::ReadBreakLog((lr.work / "breaks.txt").string()), contacts);
+  const auto fly = post::TallyContacts(contacts, "flywheel"),
+             wall = post::TallyContacts(contacts, "housing");
+  post::MillRegions regions;
+  regions.axis_x = g.axis_x;
+  regions.axis_y = g.axis_height;
+  regions.tip_radius = g.tip_radius();
+  regions.half_width_z = 0.5 * g.plate_width;
+  regions.floor_y = 0;
+  regions.roof_y = g.height;
+  const auto mass = post::LocateMass(a.snap.elements, regions);
+  double element_mass = 0;
+  for (const auto& e : a.snap.elements) element_mass += e.mass;
+
+  nlohmann::json j = lump_result_json(lr, a.result, res.seconds);
+  const auto tally = [](const post::ContactTally& t) {
+    return nlohmann::json{{"contacts", t.n},
+                          {"elements", t.n_elements},
+                          {"normal_speed_mean_m_s", t.normal_speed_mean_m_s},
+                          {"normal_speed_max_m_s", t.normal_speed_max_m_s}};
+  };
+  const auto when = [](double t) { return t >= 0 ? nlohmann::json(t) : nlohmann::json(nullptr); };
+  j["mode"] = "in_mill";
+  j["rpm"] = rpm;
+  j["start"] = {
+      {"particle_id", in.at("particle_id")},
+      {"time_in_transport_s", in.at("start_time_s")},
+      {"strike_time_in_transport_s", in.at("strike_time_s")},
+      {"position_m", in.at("position")},
+      {"velocity_m_s", in.at("velocity")},
+      {"rotor_angle_deg", in.at("rotor_angle_rad").get<double>() * 180 / kPi},
+      {"lead_time_s", d.real("breakage.in_mill.lead_time")},
+      {"note",
+       "the transport lump's state at its first flywheel strike, backed off ballistically (gravity "
+       "only) by lead_time"}};
+  j["strike"] = {{"speed_m_s", v_strike},
+                 {"normal_speed_m_s", in.at("strike_normal_speed_m_s")},
+                 {"angle_deg", a_strike}};
+  j["duration_s"] = d.real("breakage.in_mill.duration");
+  j["gas"] = gas;
+  j["element_mass_kg"] = element_mass;
+  j["bonds_broken_at_strike"] = split.at_strike;
+  j["bonds_broken_later"] = split.later;
+  j["first_flywheel_contact_s"] = when(split.first_flywheel_contact_s);
+  j["first_housing_contact_s"] = when(split.first_housing_contact_s);
+  j["strike_definition"] =
+      "at the strike: broken from the lump's first element contact with the flywheel until the "
+      "first element "
+      "contact with the housing; later: after it (housing impacts and later strikes)";
+  j["flywheel"] = tally(fly);
+  j["housing"] = tally(wall);
+  j["mass_places"] = {{"rotor", mass.rotor},
+                      {"housing", mass.housing},
+                      {"outlet", mass.outlet},
+                      {"inlet", mass.inlet}};
+  jobs::atomic_write(out_dir / "in_mill.json", j.dump(2) + "\n");
+  write_lump_outputs(out_dir, a, j);
+
+  const auto& s = a.result.summary;
+  return fmt::format(
+      "lump {} struck at {:.1f} m/s ({:.0f} deg): {} pieces ({} single), largest {:.1f}%, t10 "
+      "{:.1f}%{}; bonds broken "
+      "{:.1f}% ({} at the strike, {} later); {} flywheel and {} housing contacts; mass in the "
+      "rotor region {:.0f}%, "
+      "housing {:.0f}%, below the floor {:.0f}% [{:.1f} s]",
+      in.at("particle_id").get<long long>(), v_strike, a_strike, s.n_pieces, s.n_single,
+      100 * s.largest_mass_fraction, s.t10_percent, s.t10_resolved ? "" : " (unresolved)",
+      100 * s.broken_bond_fraction, split.at_strike, split.later, fly.n, wall.n, 100 * mass.rotor,
+      100 * mass.housing, 100 * mass.outlet, res.seconds);
+}
+
+std::string damaged_in_mill_outputs(const fs::path& dir) {
+  if (auto r = damaged_lump_outputs(dir); !r.empty()) return r;
+  return jobs::check_json(dir / "in_mill.json");
+}
+
+std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
+                                                       const std::vector<JobSpec>& jobs) {
+  const jobs::JobStore store(ctx.stage_dir);
+  const auto edges = ctx.cfg.doc.reals("breakage.size_fraction_edges");
+  const double d_mm = 1000 * ctx.cfg.doc.real("lump.diameter");
+  const auto sieves = sieves_mm(edges, d_mm);
+  struct Acc {
+    int n = 0;
+    std::vector<double> frac;
+    double single = 0, largest = 0, t10 = 0;
+    bool resolved = true;
+    long long at_strike = 0, later = 0;
+    double rotor = 0, housing = 0, outlet = 0, inlet = 0;
+  };
+  std::map<double, Acc> by_rpm;
+  std::string csv;
+  for (const auto& c : csv_columns()) csv += (csv.empty() ? "" : ",") + c;
+  csv += "\n";
+  for (const auto& job : jobs) {
+    if (!is_in_mill_job(job)) continue;
+    const fs::path jd = store.job_dir(job.label);
+    std::ifstream jf(jd / "in_mill.json");
+    const auto j = nlohmann::json::parse(jf);
+    const double rpm = job.inputs.at("rpm").get<double>();
+    Acc& a = by_rpm[rpm];
+    if (a.frac.empty()) a.frac.assign(edges.size() - 1, 0.0);
+    for (const auto& f : post::ReadFractionsCsv((jd / "fractions.csv").string()))
+      if (f.index < static_cast<int>(a.frac.size())) a.frac[f.index] += f.mass_fraction;
+    ++a.n;
+    a.single += j.at("single_mass_fraction").get<double>();
+    a.largest += j.at("largest_mass_fraction").get<double>();
+    a.t10 += j.at("t10_percent").get<double>();
+    a.resolved = a.resolved && j.at("t10_resolved").get<bool>();
+    a.at_strike += j.at("bonds_broken_at_strike").get<long long>();
+    a.later += j.at("bonds_broken_later").get<long long>();
+    const auto& m = j.at("mass_places");
+    a.rotor += m.at("rotor").get<double>();
+    a.housing += m.at("housing").get<double>();
+    a.outlet += m.at("outlet").get<double>();
+    a.inlet += m.at("inlet").get<double>();
+    csv += fmt::format(
+        "{:g},{},{},{:.9g},{:.6g},{:.6g},{},{},{},{:.9g},{:.9g},{:.6g},{},{:.9g},{},{},{},{},{:.6g}"
+        ",{:.6g},"
+        "{:.6g},{:.6g},{:.6g},{:.3f}\n",
+        rpm, job.label, j.at("start").at("particle_id").get<long long>(),
+        j.at("start").at("strike_time_in_transport_s").get<double>(),
+        j.at("strike").at("speed_m_s").get<double>(), j.at("strike").at("angle_deg").get<double>(),
+        j.at("lump").at("elements").get<long>(), j.at("n_pieces").get<long long>(),
+        j.at("n_single").get<long long>(), j.at("largest_mass_fraction").get<double>(),
+        j.at("single_mass_fraction").get<double>(), j.at("t10_percent").get<double>(),
+        j.at("t10_resolved").get<bool>() ? 1 : 0, j.at("broken_bond_fraction").get<double>(),
+        j.at("bonds_broken_at_strike").get<long long>(),
+        j.at("bonds_broken_later").get<long long>(),
+        j.at("flywheel").at("contacts").get<long long>(),
+        j.at("housing").at("contacts").get<long long>(),
+        j.at("housing").at("normal_speed_mean_m_s").get<double>(), m.at("rotor").get<double>(),
+        m.at("housing").get<double>(), m.at("outlet").get<double>(), m.at("inlet").get<double>(),
+        j.at("wall_seconds").get<double>());
+  }
+  std::map<double, nlohmann::json> out;
+  if (by_rpm.empty()) return out;
+  jobs::atomic_write(ctx.stage_dir / "in_mill.csv", csv);
+  for (auto& [rpm, a] : by_rpm) {
+    const double n = a.n;
+    for (auto& f : a.frac) f /= n;
+    const long long broken = a.at_strike + a.later;
+    nlohmann::json e = {
+        {"lumps", a.n},
+        {"fraction_mass", a.frac},
+        {"fully_shredded_mass_fraction", a.single / n},
+        {"largest_piece_mass_fraction", a.largest / n},
+        {"t10_percent", a.t10 / n},
+        {"t10_resolved", a.resolved},
+        {"bonds_broken_at_strike_fraction",
+         broken > 0 ? nlohmann::json(static_cast<double>(a.at_strike) / broken)
+                    : nlohmann::json(nullptr)},
+        {"mass_places",
+         {{"rotor", a.rotor / n},
+          {"housing", a.housing / n},
+          {"outlet", a.outlet / n},
+          {"inlet", a.inlet / n}}},
+        {"duration_s", ctx.cfg.doc.real("breakage.in_mill.duration")},
+        {"note",
+         "bonded lumps run in the turning mill from their first flywheel strike in stage 1: "
+         "the strike, the flight and the housing impacts (breakage/in_mill.csv per run)"}};
+    e.update(passing_json(sieves, a.frac));
+    out[rpm] = e;
+    ctx.progress.info(fmt::format(
+        "[breakage] in-mill product at {:g} rpm ({} lump{}): fully shredded {:.1f}% of the mass, "
+        "largest piece {:.1f}%, "
+        "t10 {:.1f}%{}, {} of the broken bonds broke at the beater strike",
+        rpm, a.n, a.n == 1 ? "" : "s", 100 * a.single / n, 100 * a.largest / n, a.t10 / n,
+        a.resolved ? "" : " (unresolved)",
+        broken > 0 ? fmt::format("{:.0f}%", 100.0 * a.at_strike / broken) : std::string("none")));
+  }
+  return out;
+}
+
+}  // namespace mill

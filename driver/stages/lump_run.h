@@ -1,0 +1,69 @@
+// What every bonded-lump run of the breakage stage shares, the single impact
+// on a plane (impact.in.tmpl) and the lump in the turning mill
+// (in_mill.in.tmpl): the lump with its calibrated bonds and random
+// orientation, the decks' -var settings for them, and the fragment analysis
+// of the final state with its outputs (summary.csv, fractions.csv, impact.h5,
+// fragments.vtp, result.json), each complete or absent.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "postprocess/breakage_results.h"
+#include "postprocess/lammps_dump.h"
+#include "stages/lump_builder.h"
+#include "stages/material.h"
+#include "stages/stage.h"
+
+namespace mill {
+
+struct LumpRun {
+  LumpInfo lump;
+  BondParams bond;
+  std::array<double, 4> rotation{};  // axis x, y, z and angle (deg)
+  double r_min = 0;                  // smallest element radius of the builder's classes, m
+  std::filesystem::path work;        // the engine's run folder (out_dir/run), emptied
+};
+
+// Builds (or reuses) the lump of repeat `repeat` (packing repeat mod
+// lump.n_packings), its random orientation (from lump.seed and the repeat)
+// and an empty run folder out_dir/run.
+LumpRun prepare_lump_run(StageContext& ctx, int repeat, const std::filesystem::path& out_dir,
+                         const std::string& label);
+
+// -var pairs every lump deck takes: the shared deck pieces' folder, the lump
+// file, its orientation, the bonding rule, the ore and the bonds.
+std::vector<std::pair<std::string, std::string>> lump_deck_vars(const StageContext& ctx,
+                                                                const LumpRun& run);
+
+struct LumpRunResult {
+  post::DumpSnapshot snap;
+  post::ImpactResult result;
+};
+
+// Reads the run's bonds_initial.txt, final.dump and bonds_final.txt (in
+// run.work) and analyses the fragments. Throws when elements were lost.
+LumpRunResult analyse_lump_run(StageContext& ctx, const LumpRun& run,
+                               const post::ImpactConditions& conditions, double wall_seconds,
+                               const std::string& label);
+
+// result.json of a run: the conditions, the lump, the bonds and the fragment
+// summary (callers add their own keys).
+nlohmann::json lump_result_json(const LumpRun& run, const post::ImpactResult& r,
+                                double wall_seconds);
+
+// Writes summary.csv, fractions.csv, impact.h5, fragments.vtp and
+// result.json into out_dir, each complete or absent.
+void write_lump_outputs(const std::filesystem::path& out_dir, const LumpRunResult& a,
+                        const nlohmann::json& result);
+
+// The outputs write_lump_outputs writes exist and parse: "" or the reason.
+std::string damaged_lump_outputs(const std::filesystem::path& dir);
+
+nlohmann::json bond_json(const BondParams& b);
+
+}  // namespace mill

@@ -1,0 +1,236 @@
+// In-mill breakage end to end on the tiny mill with a 40-element lump:
+// stage 1's impacts are written by hand (one lump the beater strikes, one
+// flying above the rotor into the housing wall); the campaign is killed
+// while the second in-mill run is going, and resumed. Then: the struck lump
+// broke at the strike, the other only against the housing (and the record
+// says none broke at the strike), element mass is conserved, and
+// product.json and in_mill.csv hold the in-mill product.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "e2e_util.h"
+#include "postprocess/breakage_results.h"
+#include "postprocess/flow_field_io.h"
+#include "postprocess/lammps_dump.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using namespace mill::e2e;
+using mill::jobs::State;
+
+const std::string kData = MILL_TEST_DATA;
+constexpr double kPi = 3.14159265358979323846;
+
+// One impacts.csv row: lump `id` at `x`, lab velocity `v`, contact point `c`
+// on the flywheel (axis at (0, 0.45), 2000 rpm), normal `n`.
+std::string row(int id, double t, std::array<double, 3> x, std::array<double, 3> v,
+                std::array<double, 3> c, std::array<double, 3> n) {
+  const double w = 2000 * 2 * kPi / 60;
+  const double rx = c[0], ry = c[1] - 0.45;
+  const std::array<double, 3> vr = {v[0] + w * ry, v[1] - w * rx, v[2]};
+  const double speed = std::hypot(vr[0], vr[1], vr[2]);
+  const double vn = std::max(0.6, -(vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2]));
+  const double vt = std::sqrt(std::max(0.0, speed * speed - vn * vn));
+  return fmt::format("{},{},flywheel,{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", t,
+                     id, x[0], x[1], x[2], c[0], c[1], c[2], n[0], n[1], n[2], vr[0], vr[1], vr[2],
+                     speed, vn, vt, std::asin(std::min(1.0, vn / speed)) * 180 / kPi,
+                     w * std::hypot(rx, ry), std::hypot(v[0], v[1], v[2]), std::hypot(rx, ry));
+}
+
+// Lump 1: falling at 5 m/s onto plate 0's leading face, which points up at
+// t = (pi/2) / omega. Lump 2: flying at 60 m/s well above the rotor (tip at
+// y = 0.70 m) towards the housing wall at x = 0.4 m.
+void write_transport_impacts(const fs::path& run) {
+  fs::create_directories(run / "transport/rpm2000");
+  const double t = 0.5 * kPi / (2000 * 2 * kPi / 60);
+  spit(run / "transport/rpm2000/impacts.csv",
+       "time_s,particle_id,surface,x_m,y_m,z_m,contact_x_m,contact_y_m,contact_z_m,normal_x,normal_"
+       "y,normal_z,"
+       "vrel_x_m_s,vrel_y_m_s,vrel_z_m_s,speed_m_s,normal_speed_m_s,tangential_speed_m_s,angle_deg,"
+       "surface_speed_m_s,"
+       "particle_speed_m_s,axis_distance_m\n" +
+           row(1, t, {-0.021, 0.62, 0}, {0, -5, 0}, {-0.01, 0.62, 0}, {-1, 0, 0}) +
+           row(2, t, {0.2, 0.95, 0}, {60, 0, 0}, {0.2, 0.94, 0}, {0, 1, 0}));
+}
+
+// Mass of the elements of a LIGGGHTS granular data file (id type diameter density x y z).
+double data_file_mass(const fs::path& f) {
+  std::istringstream in(slurp(f));
+  std::string line;
+  bool atoms = false;
+  double m = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("Atoms", 0) == 0) {
+      atoms = true;
+      continue;
+    }
+    if (atoms && (line.rfind("Velocities", 0) == 0 || line.rfind("Bonds", 0) == 0)) break;
+    std::istringstream ls(line);
+    double id, type, d, rho;
+    if (atoms && (ls >> id >> type >> d >> rho)) m += rho * kPi / 6 * d * d * d;
+  }
+  return m;
+}
+
+TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAKill) {
+  const fs::path dir = scratch("in_mill");
+  write_transport_impacts(dir);
+  const std::string yaml = kData + "/tiny_in_mill.yaml";
+  ASSERT_EQ(
+      orchestrate("--case " + yaml + " --stage breakage --list-tasks --output " + dir.string(),
+                  dir / "tasks.log"),
+      0)
+      << slurp(dir / "tasks.log");
+  for (const char* l : {"rpm2000_mill_p1", "rpm2000_mill_p2"})
+    EXPECT_NE(slurp(dir / "tasks.log").find(l), std::string::npos) << slurp(dir / "tasks.log");
+
+  // Killed while the second in-mill run is going.
+  const std::vector<std::string> args = {"--case", yaml, "--stage",  "breakage",
+                                         "--jobs", "1",  "--output", dir.string()};
+  const pid_t pid = spawn_orchestrate(args, dir / "killed.log");
+  const fs::path stage = dir / "breakage";
+  const bool ready = wait_for(
+      [&] {
+        return job_state(stage, "rpm2000_mill_p1") == State::Done &&
+               job_state(stage, "rpm2000_mill_p2") == State::Running;
+      },
+      600);
+  if (!ready) kill(pid, SIGKILL);
+  ASSERT_TRUE(ready) << slurp(dir / "killed.log");
+  kill(pid, SIGTERM);
+  EXPECT_EQ(finish(pid), 128 + SIGTERM) << slurp(dir / "killed.log");
+  EXPECT_EQ(job_state(stage, "rpm2000_mill_p2"), State::Failed);
+  EXPECT_FALSE(fs::exists(stage / "jobs/rpm2000_mill_p2/in_mill.json"));
+  const auto t_first = fs::last_write_time(stage / "jobs/rpm2000_mill_p1/STATUS");
+  std::string line;
+  for (const auto& a : args) line += "'" + a + "' ";
+  ASSERT_EQ(orchestrate(line, dir / "resumed.log"), 0) << slurp(dir / "resumed.log");
+  EXPECT_EQ(fs::last_write_time(stage / "jobs/rpm2000_mill_p1/STATUS"), t_first)
+      << "the finished run was redone";
+  EXPECT_NE(slurp(dir / "resumed.log").find("2 already done"), std::string::npos)
+      << slurp(dir / "resumed.log");
+
+  // The struck lump: the beater broke it.
+  const auto struck = nlohmann::json::parse(slurp(stage / "jobs/rpm2000_mill_p1/in_mill.json"));
+  EXPECT_GT(struck.at("flywheel").at("contacts").get<long>(), 0) << struck.dump(2);
+  EXPECT_GT(struck.at("bonds_broken_at_strike").get<long>(), 0) << struck.dump(2);
+  EXPECT_LT(struck.at("largest_mass_fraction").get<double>(), 1.0) << struck.dump(2);
+  // The unreachable lump: no beater contact, nothing broken at a strike.
+  const auto missed = nlohmann::json::parse(slurp(stage / "jobs/rpm2000_mill_p2/in_mill.json"));
+  EXPECT_EQ(missed.at("flywheel").at("contacts").get<long>(), 0) << missed.dump(2);
+  EXPECT_EQ(missed.at("bonds_broken_at_strike").get<long>(), 0) << missed.dump(2);
+  EXPECT_GT(missed.at("housing").at("contacts").get<long>(), 0) << missed.dump(2);
+
+  // Element mass is conserved over the fragments.
+  for (const char* l : {"rpm2000_mill_p1", "rpm2000_mill_p2"}) {
+    const fs::path jd = stage / "jobs" / l;
+    const auto j = nlohmann::json::parse(slurp(jd / "in_mill.json"));
+    const fs::path lump_file =
+        mill::jobs::JobStore(stage / "lumps").job_dir(j.at("lump").at("label").get<std::string>()) /
+        "lump.data";
+    ASSERT_TRUE(fs::exists(lump_file)) << lump_file;
+    const double m0 = data_file_mass(lump_file);
+    // The data file and the dump carry about 7 significant digits.
+    EXPECT_NEAR(j.at("element_mass_kg").get<double>(), m0, 1e-6 * m0) << l;
+    double sum = 0;
+    for (const auto& f : mill::post::ReadFractionsCsv((jd / "fractions.csv").string()))
+      sum += f.mass_fraction;
+    EXPECT_NEAR(sum, 1.0, 1e-9) << l;
+    const auto& places = j.at("mass_places");
+    EXPECT_NEAR(places.at("rotor").get<double>() + places.at("housing").get<double>() +
+                    places.at("outlet").get<double>() + places.at("inlet").get<double>(),
+                1.0, 1e-9)
+        << l;
+  }
+
+  // The product: the single impact's entries and the in-mill object.
+  const auto product = nlohmann::json::parse(slurp(stage / "product.json"));
+  ASSERT_EQ(product.size(), 1u);
+  const auto& m = product[0].at("in_mill");
+  EXPECT_EQ(m.at("lumps").get<int>(), 2);
+  for (const char* k :
+       {"fully_shredded_mass_fraction", "largest_piece_mass_fraction", "t10_percent",
+        "t10_resolved", "bonds_broken_at_strike_fraction", "passing_percent"})
+    EXPECT_TRUE(m.contains(k)) << k;
+  EXPECT_TRUE(product[0].contains("fully_shredded_mass_fraction"));
+  std::istringstream csv(slurp(stage / "in_mill.csv"));
+  int rows = 0;
+  while (std::getline(csv, line)) ++rows;
+  EXPECT_EQ(rows, 3);  // header and two runs
+
+  // The report's headline has the in-mill row beside the single impact's.
+  ASSERT_EQ(orchestrate("--case " + yaml + " --stage report --output " + dir.string(),
+                        dir / "report.log"),
+            0)
+      << slurp(dir / "report.log");
+  EXPECT_NE(slurp(dir / "report/index.html")
+                .find("in the mill (2 lumps, strike and housing impacts), 2000 rpm"),
+            std::string::npos);
+}
+
+// With gas: still air of 1.2 kg/m3 over the tiny housing (a field where the
+// sample stage puts it); the run takes the drag and says so. One lump of the
+// two is chosen: the one of the median strike normal speed, lump 2 (41.9 m/s
+// against 35.7), the one the beater cannot reach.
+TEST(InMill, GasDragFromTheSampledField) {
+  const fs::path dir = scratch("in_mill_gas");
+  write_transport_impacts(dir);
+  mill::post::FlowField f;
+  const double h = 0.05;
+  f.origin = {-0.4, 0.0, -0.15};
+  f.spacing = {h, h, h};
+  f.dims = {17, 25, 7};
+  f.allocate(false);
+  for (size_t p = 0; p < f.mask.size(); ++p) {
+    f.mask[p] = 1;
+    f.rho[p] = 1.2;
+  }
+  f.rpm = 2000;
+  f.gas_model = "incompressible";
+  f.source = "synthetic: still air (test_in_mill_e2e)";
+  mill::post::write_flow_field(dir / "sample/rpm2000/field.h5", f);
+  std::string yaml = slurp(kData + "/tiny_in_mill.yaml");
+  const std::string from = "in_mill: {lumps: 2, duration: 8.0e-3, lead_time: 2.0e-3, gas: false}";
+  ASSERT_NE(yaml.find(from), std::string::npos);
+  yaml.replace(yaml.find(from), from.size(),
+               "in_mill: {lumps: 1, duration: 4.0e-3, lead_time: 2.0e-3, gas: true}");
+  spit(dir / "case.yaml", yaml);
+  ASSERT_EQ(orchestrate("--case " + (dir / "case.yaml").string() + " --stage breakage --output " +
+                            dir.string(),
+                        dir / "run.log"),
+            0)
+      << slurp(dir / "run.log");
+  const auto j = nlohmann::json::parse(slurp(dir / "breakage/jobs/rpm2000_mill_p2/in_mill.json"));
+  EXPECT_TRUE(j.at("gas").get<bool>());
+  EXPECT_EQ(j.at("bonds_broken_at_strike").get<long>(), 0) << j.dump(2);
+  EXPECT_NE(
+      slurp(dir / "breakage/jobs/rpm2000_mill_p2/run/liggghts.log").find("in_mill: gas drag from"),
+      std::string::npos);
+}
+
+// With gas but no sampled field the in-mill run fails and says what makes it.
+TEST(InMill, MissingFieldNamesFileCommandAndKey) {
+  const fs::path dir = scratch("in_mill_nofield");
+  write_transport_impacts(dir);
+  std::string yaml = slurp(kData + "/tiny_in_mill.yaml");
+  const std::string from = "gas: false}";
+  ASSERT_NE(yaml.find(from), std::string::npos);
+  yaml.replace(yaml.find(from), from.size(), "gas: true}");
+  spit(dir / "case.yaml", yaml);
+  const int st = orchestrate("--case " + (dir / "case.yaml").string() +
+                                 " --stage breakage --task 1 --output " + dir.string(),
+                             dir / "log");
+  EXPECT_NE(st, 0);
+  const std::string log = slurp(dir / "log");
+  EXPECT_NE(log.find("sample/rpm2000/field.h5"), std::string::npos) << log;
+  EXPECT_NE(log.find("--stage sample"), std::string::npos) << log;
+  EXPECT_NE(log.find("breakage.in_mill.gas: false"), std::string::npos) << log;
+}
+
+}  // namespace
