@@ -118,7 +118,8 @@ def main(argv=None):
         if "in_mill" in e:
             m = e["in_mill"]
             ax2.semilogx(m["sieves_mm"], m["passing_percent"], "o:", ms=3, mfc="white", color=line.get_color(),
-                         label=f"{e['rpm']:g} rpm, in mill ({m.get('lumps', '?')} lumps)")
+                         label=f"{e['rpm']:g} rpm, in mill ({m.get('lumps', '?')} "
+                               f"lump{'' if m.get('lumps') == 1 else 's'})")
     ax2.axhline(80, color="k", ls=":", lw=0.8)
     ax2.set_xlabel("size [mm]")
     ax2.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:g}"))
