@@ -91,7 +91,8 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan) {
   std::vector<post::StrikeStart> starts;
   try {
     starts = post::SelectStrikeStarts(post::ReadImpactsCsv(f.string()), static_cast<int>(k),
-                                      d.real("breakage.in_mill.lead_time"), rotor);
+                                      d.real("breakage.in_mill.lead_time"), rotor,
+                                      d.real("transport.sliding_threshold"));
   } catch (const post::PostError& e) {
     throw MissingInput(fmt::format("in-mill breakage at {} (breakage.in_mill.lumps {}): {}: {}",
                                    rpm_label(rpm), k, f.string(), e.what()));
@@ -104,7 +105,8 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan) {
                                    "breakage.in_mill.duration",
                                    "breakage.in_mill.lead_time",
                                    "breakage.in_mill.gas",
-                                   "breakage.in_mill.neighbour_bins"};
+                                   "breakage.in_mill.neighbour_bins",
+                                   "transport.sliding_threshold"};
   if (gas)
     for (const char* p : {"gas.", "flow.", "sample."}) keys.push_back(p);
   nlohmann::json base = case_keys(d, keys);
