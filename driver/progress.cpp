@@ -26,20 +26,47 @@ void Progress::clear_line() {
   }
 }
 
+double Progress::eta_seconds(const std::vector<RunningJob>& running, int queued, int finished,
+                             double finished_seconds, int slots) {
+  double sum_projected = 0, longest = 0, total_projected = 0;
+  int n_projected = 0;
+  for (const auto& r : running)
+    if (r.fraction >= 0.02) {
+      const double left = r.seconds * (1.0 - std::min(r.fraction, 1.0)) / r.fraction;
+      sum_projected += left;
+      longest = std::max(longest, left);
+      total_projected += r.seconds / r.fraction;
+      ++n_projected;
+    }
+  double mean_job = -1;
+  if (finished > 0)
+    mean_job = finished_seconds / finished;
+  else if (n_projected > 0)
+    mean_job = total_projected / n_projected;
+  const int unknown = queued + static_cast<int>(running.size()) - n_projected;
+  if (unknown > 0 && mean_job < 0) return -1;
+  const double work = sum_projected + (unknown > 0 ? unknown * mean_job : 0.0);
+  if (unknown == 0 && n_projected == 0) return -1;
+  return std::max(longest, work / std::max(1, slots));
+}
+
 std::string Progress::status_text() const {
   std::string s = fmt::format("[{}] {}/{} jobs done", stage_, done_ + skipped_, total_);
   if (failed_) s += fmt::format(", {} failed", failed_);
-  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - stage_t0_).count();
-  // ETA: mean wall time of the jobs run so far, times what is left, over the
-  // jobs running at once; a running job counts by its reported fraction.
-  double work_done = done_;
-  for (const auto& [label, st] : running_)
-    if (st.second > 0) work_done += std::min(st.second, 1.0);
+  const auto now = std::chrono::steady_clock::now();
+  std::vector<RunningJob> running;
+  for (const auto& [label, st] : running_) {
+    const auto t0 = started_.find(label);
+    const double t =
+        t0 == started_.end() ? 0.0 : std::chrono::duration<double>(now - t0->second).count();
+    running.push_back({t, st.second});
+  }
   const int left = total_ - done_ - skipped_ - failed_;
-  if (work_done > 0.05 && left > 0) {
-    const double per_job = elapsed / work_done * std::max<size_t>(1, running_.size());
-    const double remaining = (left - (work_done - done_)) * per_job / std::max<size_t>(1, running_.size());
-    s += ", ETA " + duration(remaining);
+  const int queued = std::max(0, left - static_cast<int>(running.size()));
+  if (left > 0) {
+    const double eta = eta_seconds(running, queued, done_, job_seconds_,
+                                   std::max<int>(1, static_cast<int>(running.size())));
+    if (eta >= 0) s += ", ETA " + duration(eta);
   }
   for (const auto& [label, st] : running_) {
     s += " | " + label;
@@ -71,7 +98,8 @@ void Progress::stage_begin(const std::string& stage, int total, int already_done
   job_seconds_ = 0;
   running_.clear();
   stage_t0_ = std::chrono::steady_clock::now();
-  out_ << fmt::format("== stage {}: {} job{}, {} already done\n", stage, total, total == 1 ? "" : "s", already_done)
+  out_ << fmt::format("== stage {}: {} job{}, {} already done\n", stage, total,
+                      total == 1 ? "" : "s", already_done)
        << std::flush;
   last_draw_ = {};
 }
@@ -102,8 +130,8 @@ void Progress::job_end(const std::string& label, bool ok, double seconds) {
     ++failed_;
   }
   clear_line();
-  out_ << fmt::format("[{}] {} {} in {} ({}/{})\n", stage_, ok ? "done" : "FAILED", label, duration(seconds),
-                      done_ + skipped_, total_)
+  out_ << fmt::format("[{}] {} {} in {} ({}/{})\n", stage_, ok ? "done" : "FAILED", label,
+                      duration(seconds), done_ + skipped_, total_)
        << std::flush;
   draw(true);
 }
@@ -111,9 +139,10 @@ void Progress::job_end(const std::string& label, bool ok, double seconds) {
 void Progress::stage_end() {
   std::lock_guard<std::mutex> g(mu_);
   clear_line();
-  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - stage_t0_).count();
-  out_ << fmt::format("== stage {} finished: {} run, {} skipped (done before), {} failed, {}\n", stage_, done_,
-                      skipped_, failed_, duration(elapsed))
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - stage_t0_).count();
+  out_ << fmt::format("== stage {} finished: {} run, {} skipped (done before), {} failed, {}\n",
+                      stage_, done_, skipped_, failed_, duration(elapsed))
        << std::flush;
 }
 

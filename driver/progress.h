@@ -8,6 +8,7 @@
 #include <mutex>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace mill {
 
@@ -26,6 +27,22 @@ class Progress {
 
   // "1m 05s", "3h 02m": a compact duration.
   static std::string duration(double seconds);
+
+  // A running job: seconds since it started and the fraction it reported
+  // (< 0 if none yet).
+  struct RunningJob {
+    double seconds = 0;
+    double fraction = -1;
+  };
+  // Seconds until the stage is done, or < 0 when there is nothing to go on.
+  // Each running job that reported a fraction f after t seconds needs
+  // t (1 - f) / f more (jobs of one stage may differ a hundredfold, e.g. an
+  // in-mill lump beside single impacts); a running job without a fraction
+  // and each queued job count as the mean finished job (or as the mean
+  // projected running job when none has finished). Jobs run `slots` at a
+  // time: the stage ends no earlier than its longest running job.
+  static double eta_seconds(const std::vector<RunningJob>& running, int queued, int finished,
+                            double finished_seconds, int slots);
 
  private:
   void draw(bool force);
