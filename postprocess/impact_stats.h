@@ -1,8 +1,8 @@
 // Impact statistics of the transport stage: reading the impact/recorder CSVs
 // (onsets and contact ends) and the trajectory dump, the struck part of each
 // contact, first and later beater strikes, sliding contacts, the
-// strike-to-housing chain, the per-surface and per-particle statistics, and
-// the results file transport.h5 (units as attributes). No driver/ includes.
+// strike-to-housing chain, and the per-surface and per-particle statistics
+// (postprocess/transport_h5 writes them to transport.h5). No driver/ includes.
 #pragma once
 
 #include <array>
@@ -159,20 +159,5 @@ struct TransportStats {
 TransportStats ComputeTransportStats(const std::vector<ImpactRecord>& records,
                                      const std::vector<double>& insert_time_s,
                                      const std::vector<ContactEnd>& ends = {});
-
-// Scalars and geometry for the root/geometry attributes of transport.h5.
-struct TransportMeta {
-  std::map<std::string, double> scalars;     // e.g. "rpm", "rim_speed_m_s"
-  std::map<std::string, std::string> units;  // unit per scalar ("" if none)
-  std::map<std::string, double> geometry;    // housing_height, tip_radius, ... (m)
-};
-
-// Writes transport.h5 (temp file, then rename): /impacts/*, /contact_ends/*,
-// /strikes/*, /particles/*, /trajectories/*, /geometry attributes, root
-// attributes from meta.
-void WriteTransportH5(const std::string& path, const std::vector<ImpactRecord>& records,
-                      const TransportStats& stats, const std::vector<double>& insert_time_s,
-                      const Trajectories& traj, const TransportMeta& meta,
-                      const std::vector<ContactEnd>& ends = {});
 
 }  // namespace mill::post

@@ -15,6 +15,7 @@
 #include "jobs/output_checks.h"
 #include "postprocess/flow_field_io.h"
 #include "postprocess/impact_stats.h"
+#include "postprocess/transport_h5.h"
 #include "progress.h"
 #include "stages/stage_util.h"
 

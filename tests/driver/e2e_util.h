@@ -1,6 +1,6 @@
 // Helpers shared by the end-to-end tests that run the real `orchestrate`
 // (with the project's liggghts-mill): scratch folders, running and spawning
-// the program, reading files and job states.
+// the program, reading files and job states, the tiny housing's gas field.
 #pragma once
 
 #include <signal.h>
@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "jobs/job_store.h"
+#include "postprocess/flow_field_io.h"
 
 namespace mill::e2e {
 
@@ -95,6 +96,22 @@ inline void keep_run(const fs::path& run) {
   fs::create_directories(link.parent_path());
   fs::remove_all(link);
   fs::create_directory_symlink(fs::absolute(run), link);
+}
+
+// A gas field on the grid over the tiny mill's housing (x -0.4..0.4, y 0..1.2,
+// z -0.15..0.15 m, 50 mm spacing) for the rotor at `rpm`, incompressible:
+// U, rho and mask allocated and 0 (no gas) for the test to fill.
+inline post::FlowField tiny_housing_field(double rpm, const std::string& source) {
+  post::FlowField f;
+  const double h = 0.05;
+  f.origin = {-0.4, 0.0, -0.15};
+  f.spacing = {h, h, h};
+  f.dims = {17, 25, 7};
+  f.allocate(false);
+  f.rpm = rpm;
+  f.gas_model = "incompressible";
+  f.source = source;
+  return f;
 }
 
 // State of job `label` of the stage whose folder is `stage_dir`.

@@ -181,19 +181,11 @@ TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAK
 TEST(InMill, GasDragFromTheSampledField) {
   const fs::path dir = scratch("in_mill_gas");
   write_transport_impacts(dir);
-  mill::post::FlowField f;
-  const double h = 0.05;
-  f.origin = {-0.4, 0.0, -0.15};
-  f.spacing = {h, h, h};
-  f.dims = {17, 25, 7};
-  f.allocate(false);
+  mill::post::FlowField f = tiny_housing_field(2000, "synthetic: still air (test_in_mill_e2e)");
   for (size_t p = 0; p < f.mask.size(); ++p) {
     f.mask[p] = 1;
     f.rho[p] = 1.2;
   }
-  f.rpm = 2000;
-  f.gas_model = "incompressible";
-  f.source = "synthetic: still air (test_in_mill_e2e)";
   mill::post::write_flow_field(dir / "sample/rpm2000/field.h5", f);
   std::string yaml = slurp(kData + "/tiny_in_mill.yaml");
   const std::string from = "in_mill: {lumps: 2, duration: 8.0e-3, lead_time: 2.0e-3, gas: false}";

@@ -52,12 +52,11 @@ void write_unconverged_sample_report(const fs::path& file) {
 // Solid-body rotation at a tenth of the rotor speed about the rotor axis plus
 // a 2 m/s downdraft, inside the housing; no gas inside the hub.
 void write_synthetic_field(const fs::path& file) {
-  mill::post::FlowField f;
-  const double h = 0.05;
-  f.origin = {-0.4, 0.0, -0.15};
-  f.spacing = {h, h, h};
-  f.dims = {17, 25, 7};
-  f.allocate(false);
+  mill::post::FlowField f = tiny_housing_field(
+      2000,
+      "synthetic: solid-body rotation at 0.1 x rotor speed plus a 2 m/s downdraft "
+      "(test_transport_e2e)");
+  const double h = f.spacing[0];
   const double omega = 0.1 * 2000 * 2 * kPi / 60, ax = 0.0, ay = 0.45;
   for (int k = 0; k < f.dims[2]; ++k)
     for (int j = 0; j < f.dims[1]; ++j)
@@ -72,11 +71,6 @@ void write_synthetic_field(const fs::path& file) {
         f.U[3 * p + 1] = omega * rx - 2.0;
         f.rho[p] = 1.2;
       }
-  f.rpm = 2000;
-  f.gas_model = "incompressible";
-  f.source =
-      "synthetic: solid-body rotation at 0.1 x rotor speed plus a 2 m/s downdraft "
-      "(test_transport_e2e)";
   mill::post::write_flow_field(file, f);
 }
 

@@ -1,5 +1,6 @@
 // Tests of postprocess/impact_stats: the impact CSV and trajectory readers,
-// the statistics on hand-made impact lists, and transport.h5 units.
+// the statistics on hand-made impact lists; and of postprocess/transport_h5:
+// transport.h5 units.
 #include "postprocess/impact_stats.h"
 
 #include <gtest/gtest.h>
@@ -12,6 +13,7 @@
 
 #include "postprocess/flow_field_io.h"
 #include "postprocess/fragments.h"
+#include "postprocess/transport_h5.h"
 
 namespace fs = std::filesystem;
 using namespace mill::post;
