@@ -126,12 +126,12 @@ Schema make_case_schema() {
 
       // --- CFD numerics ---
       choice("flow.mesh_preset", "quick", {"tiny", "quick", "medium", "reference"},
-             "tiny: a few thousand cells (tests); quick: tens of thousands (0.1 m background cells, first-order momentum); medium: 0.07 m cells with boundary layers; reference: 0.05 m cells with boundary layers (medium and reference: second-order momentum, see flow.first_order_iterations); cell counts in docs/flow.md"),
+             "tiny: a few thousand cells (tests); quick: tens of thousands (0.1 m background cells); medium: 0.07 m cells with boundary layers; reference: 0.05 m cells with boundary layers; all first-order momentum (flow.momentum_scheme); cell counts and the mesh study in docs/flow.md"),
       range(key("flow.rotor_angle", T::Real, "deg", "0",
                 "Frozen-rotor position of the flywheel in the CFD (counter-clockwise about +z; 0: plate 0 along +x). The steady MRF solution depends on it; bench/README.md, \"Flow\", measures the spread over positions"),
             0, false, 360, true),
       choice("flow.momentum_scheme", "preset", {"preset", "upwind", "linearUpwind"},
-             "Convection of momentum: preset = the mesh preset's (upwind for tiny and quick, linearUpwind for medium and reference); upwind = first order, robust; linearUpwind = second order (started with flow.first_order_iterations of upwind)"),
+             "Convection of momentum: preset = the mesh preset's (upwind on every preset); upwind = first order, converges on all presets; linearUpwind = second order (started with flow.first_order_iterations of upwind; does not converge on medium and reference: the plate wakes oscillate, docs/flow.md)"),
       at_least(key("flow.first_order_iterations", T::Int, "", "300",
                    "With second-order momentum (flow.momentum_scheme), first run this many iterations with first-order upwind, then switch (the solver restarts from that state); 0: second order from the start"),
                0),

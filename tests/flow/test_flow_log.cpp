@@ -106,3 +106,41 @@ TEST(FlowTemplate, MatchesTheDefaultCase) {
   }
   fs::remove_all(d);
 }
+
+namespace {
+// The z of "zonePoint1/2 (x y z);" in a caseParameters text.
+double zone_z(const std::string& params, const std::string& entry) {
+  const auto at = params.find("\n" + entry);
+  EXPECT_NE(at, std::string::npos) << entry;
+  if (at == std::string::npos) return NAN;
+  std::istringstream in(params.substr(params.find('(', at) + 1));
+  double x = 0, y = 0, z = 0;
+  in >> x >> y >> z;
+  return z;
+}
+}  // namespace
+
+// The rotating zone covers the flywheel (|z| <= plate_width / 2) and ends
+// midway to the front/back walls, so no stationary wall lies in it (a zone
+// reaching the walls kept the layered meshes from converging; docs/flow.md).
+TEST(FlowTemplate, RotorZoneEndsBetweenFlywheelAndWalls) {
+  const fs::path project = MILL_PROJECT_DIR;
+  for (const char* domain : {"half", "full"})
+    for (const char* width : {"0.3", "0.45"}) {
+      const auto cfg = mill::config::load_case(
+          project / "cases" / "default.yaml", project,
+          {{"flow.domain", domain}, {"mill.flywheel.plate_width", width}});
+      const double pw = cfg.doc.real("mill.flywheel.plate_width");
+      const double wall = 0.5 * cfg.doc.real("mill.housing.depth");
+      const std::string p = case_parameters(cfg.doc, 2000, mesh_preset("quick"), 1);
+      const double z2 = zone_z(p, "zonePoint2"), z1 = zone_z(p, "zonePoint1");
+      SCOPED_TRACE(std::string(domain) + " domain, plate width " + width);
+      EXPECT_NEAR(z2, 0.5 * (0.5 * pw + wall), 1e-9);
+      EXPECT_GT(z2, 0.5 * pw);
+      EXPECT_LT(z2, wall);
+      if (std::string(domain) == "full") EXPECT_NEAR(z1, -z2, 1e-9);
+      else EXPECT_LT(z1, 0.0);  // the half domain's zone reaches through the symmetry plane
+      // The refinement cylinder still spans the whole depth.
+      EXPECT_GT(zone_z(p, "axisPoint2"), wall);
+    }
+}
