@@ -29,6 +29,9 @@ namespace flow {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// Start-up temperature guard (system/fvOptions limitT): these multiples of
+// gas.temperature, written to caseParameters and checked in the report.
+constexpr double kTGuardMin = 0.5, kTGuardMax = 3.0;
 
 // Background cell count along an edge of length L for cell size h (>= 2).
 int cells_along(double L, double h) { return std::max(2, static_cast<int>(std::lround(L / h))); }
@@ -390,7 +393,7 @@ std::string case_parameters(const config::Document& doc, double rpm, const MeshP
   // times the kinematic pressure (simpleFoam)
   // limits of the start-up temperature guard (system/fvOptions, compressible)
   s += fmt::format("TMinLimit       {:.10g};\nTMaxLimit       {:.10g};\n",
-                   0.5 * doc.real("gas.temperature"), 3.0 * doc.real("gas.temperature"));
+                   kTGuardMin * doc.real("gas.temperature"), kTGuardMax * doc.real("gas.temperature"));
   s += fmt::format("forcesRho       {};\n", comp ? "rho" : "rhoInf");
   if (comp) {
     s += "pDims           [1 -1 -2 0 0 0 0];  // Pa, absolute\n";
@@ -768,10 +771,11 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
     if (tmin.size() >= 2 && tmax.size() >= 2) {
       const double t_ref = doc.real("gas.temperature");
       const double lo = std::stod(tmin[1]), hi = std::stod(tmax[1]);
-      const bool clipped = lo <= 0.5 * t_ref * 1.0001 || hi >= 3.0 * t_ref * 0.9999;
+      const double guard_lo = flow::kTGuardMin * t_ref, guard_hi = flow::kTGuardMax * t_ref;
+      const bool clipped = lo <= guard_lo * 1.0001 || hi >= guard_hi * 0.9999;
       rep["temperature_K"] = {{"min", lo},
                               {"max", hi},
-                              {"guard_limits", {0.5 * t_ref, 3.0 * t_ref}},
+                              {"guard_limits", {guard_lo, guard_hi}},
                               {"guard_clipping_at_end", clipped},
                               {"note",
                                "lowest and highest T in the gas at the last iteration; the guard "
@@ -781,7 +785,7 @@ void FlowStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& j
         ctx.progress.warn(fmt::format(
             "{}: the temperature guard still clips at the last iteration (T {:.1f}-{:.1f} K, "
             "limits {:.1f}-{:.1f} K): the solution is not trustworthy; see docs/flow.md",
-            tag, lo, hi, 0.5 * t_ref, 3.0 * t_ref));
+            tag, lo, hi, guard_lo, guard_hi));
     }
   }
   const double a_in = read_patch_area(work, "inletFlow");
