@@ -87,6 +87,7 @@ struct PairMotion {
   Vec3 wa, wb;  // spins of a and b
   Vec3 vt;      // tangential relative velocity of b's material point w.r.t. a's
   double vn;    // normal relative velocity (> 0: separating)
+  Vec3 vrel_ab; // vb - va (centres)
 };
 [[gnu::always_inline]] inline PairMotion pair_motion(Vec3 d, double len, Vec3 va, Vec3 vb, Vec3 wa,
                                                      Vec3 wb, double ra_s, double rb_s) {
@@ -99,6 +100,7 @@ struct PairMotion {
   m.rb = -arm_b * m.n;
   m.wa = wa;
   m.wb = wb;
+  m.vrel_ab = vb - va;
   const Vec3 vrel = ((vb - va) + cross(wb, m.rb)) - cross(wa, m.ra);
   m.vn = dot(vrel, m.n);
   m.vt = vrel - m.vn * m.n;
@@ -124,6 +126,8 @@ struct FixBondBreakable::BondResult {
   double strength;  // shear strength at this normal stress [Pa]
   double energy;    // elastic energy stored in the bond [J]
   double stretch;   // L - L0 [m] (< 0: compressed)
+  double damped;    // taken this step by the dashpots [J] (advance only)
+  double slipped;   // taken this step by Coulomb slip of a contact [J] (advance only)
   Vec3 centre;      // bond centre (contact point)
   int mode;         // 0 intact, 1 tension, 2 shear
 };
@@ -260,7 +264,7 @@ int FixBondBreakable::setmask() {
   mask |= PRE_EXCHANGE;
   mask |= POST_FORCE;
   mask |= POST_RUN;
-  if (dump_every_ > 0) mask |= END_OF_STEP;
+  mask |= END_OF_STEP;  // the ledger's work (and the periodic bond dump)
   return mask;
 }
 
@@ -329,6 +333,12 @@ void FixBondBreakable::setup(int /*vflag*/) {
   list_valid_ = false;  // atoms may have moved between runs
   estimate_time_step();
   compute_bonds(false);
+  if (!ledger_started_) {
+    ledger_.work.start(bond_power(), update->dt);
+    ledger_.elastic0 = ledger_.elastic;
+    ledger_started_ = true;
+    ledger_step_ = update->ntimestep;
+  }
 }
 
 // Each step: advances, checks and applies every bond.
@@ -339,9 +349,39 @@ void FixBondBreakable::post_force(int /*vflag*/) { compute_bonds(true); }
 void FixBondBreakable::setup_pre_exchange() { store_history(); }
 void FixBondBreakable::pre_exchange() { store_history(); }
 
-// Writes the periodic bond dump.
+// With the full-step velocities: the work of this step's bond forces
+// (trapezoidal rule, energy_terms.h); the periodic bond dump.
 void FixBondBreakable::end_of_step() {
+  ledger_.work.add(bond_power(), update->dt);
+  ledger_step_ = update->ntimestep;
   if (dump_every_ > 0 && update->ntimestep % dump_every_ == 0) write_bond_dump();
+}
+
+double FixBondBreakable::local_work_now() const {
+  if (ledger_step_ == update->ntimestep) return ledger_.work.value();
+  return ledger_.work.value_with(bond_power(), update->dt);
+}
+
+double FixBondBreakable::local_end_term() const {
+  const int n = std::min(atom->nlocal, static_cast<int>(fbond_.size() / 6));
+  double s = 0.0;
+  for (int i = 0; i < n; ++i)
+    s += mill::end_term(&fbond_[6 * i], &fbond_[6 * i + 3], atom->f[i], atom->torque[i], atom->rmass[i],
+                        atom->radius[i]);
+  return s;
+}
+
+// Power of this step's bond forces and torques on the owned atoms [W].
+double FixBondBreakable::bond_power() const {
+  double **v = atom->v, **omega = atom->omega;
+  const int n = std::min(atom->nlocal, static_cast<int>(fbond_.size() / 6));
+  double p = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double *fb = &fbond_[6 * i];
+    p += fb[0] * v[i][0] + fb[1] * v[i][1] + fb[2] * v[i][2] + fb[3] * omega[i][0] +
+         fb[4] * omega[i][1] + fb[5] * omega[i][2];
+  }
+  return p;
 }
 
 // Writes the bond dump at the end of every run.
@@ -565,17 +605,29 @@ inline void FixBondBreakable::evaluate_bond(const AtomArrays &at, ListedBond &bo
   double mt = bond.mt;
 
   if (advance) {
-    // Carry the stored shear force and bending moment with the bond plane.
-    const double spin = 0.5 * (dot(m.wa, n) + dot(m.wb, n)) * dt;
-    fs = rotate_onto_plane(fs, n, spin);
-    mb = rotate_onto_plane(mb, n, spin);
+    // The step's increments at its midpoint (second order): the velocities
+    // are those of the half step, so the pair's geometry is taken at the half
+    // step too, x - v dt/2. Taken at the end of the step, the increments make
+    // a first-order error that pumps energy into a tumbling bonded pair
+    // (docs/styles/fix_bond_breakable.md, "Energy").
+    const Vec3 dmid = d - (0.5 * dt) * (m.vrel_ab);
+    const double lmid = std::sqrt(dot(dmid, dmid));
+    const PairMotion h = pair_motion(dmid, lmid, load3(at.v[a]), load3(at.v[b]), m.wa, m.wb,
+                                     at.radius[a], at.radius[b]);
+    // Carry the stored shear force and bending moment with the bond plane,
+    // onto the midpoint plane, then (after the increment) onto the end plane.
+    const double half_spin = 0.25 * (dot(m.wa, n) + dot(m.wb, n)) * dt;
+    fs = rotate_onto_plane(fs, h.n, half_spin);
+    mb = rotate_onto_plane(mb, h.n, half_spin);
     // Potyondy & Cundall 2004, eq. 6: incremental shear force and moments.
     const Vec3 wrel = m.wb - m.wa;
-    const double wn = dot(wrel, n);
+    const double wn = dot(wrel, h.n);
     const double ksa_dt = bond.ksa * dt, kni_dt = bond.kni * dt;
-    fs = fs - ksa_dt * m.vt;                  // dF^s = -k^s A dU^s
-    mb = mb - kni_dt * (wrel - wn * n);       // dM^s = -k^n I dtheta^s
+    fs = fs - ksa_dt * h.vt;                  // dF^s = -k^s A dU^s
+    mb = mb - kni_dt * (wrel - wn * h.n);     // dM^s = -k^n I dtheta^s
     mt -= bond.ksj * wn * dt;                 // dM^n = -k^s J dtheta^n
+    fs = rotate_onto_plane(fs, n, half_spin);
+    mb = rotate_onto_plane(mb, n, half_spin);
     store3(bond.fs, fs);
     store3(bond.mb, mb);
     bond.mt = mt;
@@ -602,6 +654,14 @@ inline void FixBondBreakable::evaluate_bond(const AtomArrays &at, ListedBond &bo
   // Mohr-Coulomb shear strength on the mean normal stress (same sources:
   // tau_c = c - sigma_n tan(phi), tension > 0): compression raises it.
   out.strength = cohesion_ - tan_friction_ * sigma_n;
+  // Elastic energy: fn^2/(2 kn A) + |Fs|^2/(2 ks A) + |Mb|^2/(2 kn I) + Mt^2/(2 ks J);
+  // a bond that breaks now releases it (the energy ledger's "released").
+  const double inv_kn = bond.l0 * inv_modulus_;
+  out.energy = 0.5 * fn * stretch +
+               0.5 * inv_kn *
+                   (stiffness_ratio_ * fs_sq * bond.inv_area + mb_sq * bond.inv_inertia +
+                    stiffness_ratio_ * mt * mt * 0.5 * bond.inv_inertia);
+  out.damped = out.slipped = 0.0;
   out.mode = 0;
   if (out.sigma > tensile_strength_)
     out.mode = 1;
@@ -612,17 +672,13 @@ inline void FixBondBreakable::evaluate_bond(const AtomArrays &at, ListedBond &bo
     if (advance) return;  // breaks now: exerts no force from this step on
   }
 
-  // Elastic energy: fn^2/(2 kn A) + |Fs|^2/(2 ks A) + |Mb|^2/(2 kn I) + Mt^2/(2 ks J).
-  const double inv_kn = bond.l0 * inv_modulus_;
-  out.energy = 0.5 * fn * stretch +
-               0.5 * inv_kn *
-                   (stiffness_ratio_ * fs_sq * bond.inv_area + mb_sq * bond.inv_inertia +
-                    stiffness_ratio_ * mt * mt * 0.5 * bond.inv_inertia);
-
   // Force on b: spring part plus optional viscous part (fraction of critical
   // damping of the two-body normal / shear oscillator; not part of the stress).
   Vec3 fb = -fn * n + fs;
-  if (damping_ > 0.0) fb = fb - (bond.cn * m.vn * n + bond.cs * m.vt);
+  if (damping_ > 0.0) {
+    fb = fb - (bond.cn * m.vn * n + bond.cs * m.vt);
+    if (advance) out.damped = (bond.cn * m.vn * m.vn + bond.cs * dot(m.vt, m.vt)) * dt;
+  }
   out.fa = -fb;
 
   // Torques: force at the contact point plus the bond moments (on b: +M).
@@ -650,6 +706,7 @@ inline bool FixBondBreakable::evaluate_contact(const AtomArrays &at, ListedBond 
   const double stretch = len - bond.l0;
   out.mode = 0;
   out.energy = 0.0;
+  out.damped = out.slipped = 0.0;
   out.stretch = stretch;
   if (len > bond.drop_len) return false;
   if (stretch >= 0.0) {  // open: no force, no stored shear or moment (contact lost)
@@ -667,24 +724,33 @@ inline bool FixBondBreakable::evaluate_contact(const AtomArrays &at, ListedBond 
 
   const double fn = bond.kna * stretch;  // < 0: compression
   Vec3 fs = load3(bond.fs);
+  // Increments at the step's midpoint, as for a bond (evaluate_bond).
+  const Vec3 dmid = d - (0.5 * at.dt) * m.vrel_ab;
+  const PairMotion h = pair_motion(dmid, std::sqrt(dot(dmid, dmid)), load3(at.v[a]), load3(at.v[b]),
+                                   m.wa, m.wb, at.radius[a], at.radius[b]);
+  const double half_spin = 0.25 * (dot(m.wa, n) + dot(m.wb, n)) * at.dt;
   if (advance) {
-    fs = rotate_onto_plane(fs, n, 0.5 * (dot(m.wa, n) + dot(m.wb, n)) * at.dt);
-    const double ksa_dt = bond.ksa * at.dt;
-    fs = fs - ksa_dt * m.vt;
+    fs = rotate_onto_plane(fs, h.n, half_spin);
+    fs = fs - (bond.ksa * at.dt) * h.vt;
+    fs = rotate_onto_plane(fs, n, half_spin);
   }
   const double cap = tan_friction_ * (-fn), fs_mag = std::sqrt(dot(fs, fs));
   if (fs_mag > cap) {  // Coulomb slip: the stored force stays on the cone
     const double sc = fs_mag > 0.0 ? cap / fs_mag : 0.0;
     fs = sc * fs;
+    if (advance) out.slipped += cap * (fs_mag - cap) / bond.ksa;  // cap x slip
   }
   if (advance) store3(bond.fs, fs);
+  // Stored while pressed: F_n^2/(2 kn A) + |F_s|^2/(2 ks A) (+ the moments below).
+  out.energy = 0.5 * fn * stretch + 0.5 * dot(fs, fs) / bond.ksa;
 
   // Normal push on b along n, with the optional dashpot; never a pull (a
   // pair separating fast must not stick through the dashpot).
   double push = -fn;
   if (damping_ > 0.0) {
-    push -= bond.cn * m.vn;
-    push = std::max(push, 0.0);
+    const double fd = std::min(bond.cn * m.vn, push);  // the dashpot's share, never a pull
+    push -= fd;
+    if (advance) out.damped += fd * m.vn * at.dt;
   }
   const Vec3 fb = push * n + fs;
   out.fa = -fb;
@@ -702,20 +768,23 @@ inline bool FixBondBreakable::evaluate_contact(const AtomArrays &at, ListedBond 
   Vec3 mb = load3(bond.mb);
   double mt = bond.mt;
   if (advance) {
-    mb = rotate_onto_plane(mb, n, 0.5 * (dot(m.wa, n) + dot(m.wb, n)) * at.dt);
+    mb = rotate_onto_plane(mb, h.n, half_spin);
     const Vec3 wrel = m.wb - m.wa;
-    const double wn = dot(wrel, n);
-    const double kni_dt = bond.kni * at.dt;
-    mb = mb - kni_dt * (wrel - wn * n);
+    const double wn = dot(wrel, h.n);
+    mb = mb - (bond.kni * at.dt) * (wrel - wn * h.n);
     mt -= bond.ksj * wn * at.dt;
+    mb = rotate_onto_plane(mb, n, half_spin);
   }
   const double mb_cap = 0.25 * (-fn) * bond.rbond, mb_mag = std::sqrt(dot(mb, mb));
   if (mb_mag > mb_cap) {
     const double sc = mb_mag > 0.0 ? mb_cap / mb_mag : 0.0;
     mb = sc * mb;
+    if (advance) out.slipped += mb_cap * (mb_mag - mb_cap) / bond.kni;
   }
   const double mt_cap = tan_friction_ * (-fn) * 2.0 * bond.rbond / 3.0;
+  if (advance && std::fabs(mt) > mt_cap) out.slipped += mt_cap * (std::fabs(mt) - mt_cap) / bond.ksj;
   mt = std::max(-mt_cap, std::min(mt_cap, mt));
+  out.energy += 0.5 * (dot(mb, mb) / bond.kni + mt * mt / bond.ksj);
   if (advance) {
     store3(bond.mb, mb);
     bond.mt = mt;
@@ -845,7 +914,15 @@ void FixBondBreakable::compute_bonds(bool advance) {
   broken_.clear();
   contact_.clear();
   double local[4] = {0.0, 0.0, 0.0, 0.0};  // intact, new tension, new shear, energy
+  double stored = 0.0;                      // ledger: bonds and pressed contacts [J]
   BondResult r;
+  // The ledger's snapshot: forces and torques before the bonds add theirs.
+  fbond_.resize(6 * static_cast<size_t>(nlocal));
+  for (int i = 0; i < nlocal; ++i) {
+    double *fb = &fbond_[6 * i];
+    fb[0] = f[i][0], fb[1] = f[i][1], fb[2] = f[i][2];
+    fb[3] = torque[i][0], fb[4] = torque[i][1], fb[5] = torque[i][2];
+  }
 
   // Adds this rank's share of a bond's (or contact's) force and torques: both
   // ends if the partner is owned here.
@@ -879,16 +956,23 @@ void FixBondBreakable::compute_bonds(bool advance) {
   for (int e = 0; e < nlisted; ++e) {
     ListedBond &lb = list_[e];
     if (lb.state != 0.0) {  // a broken bond kept as a contact
-      if (evaluate_contact(at, lb, advance, r))
+      if (evaluate_contact(at, lb, advance, r)) {
         apply(lb);
-      else if (advance)
+        if (lb.i_lower) {
+          stored += r.energy;
+          ledger_.friction += r.slipped;
+          ledger_.damping += r.damped;
+        }
+      } else if (advance) {
         remove_later(lb);
+      }
       continue;
     }
     evaluate_bond(at, lb, advance, r);
 
     if (advance && r.mode != 0) {
       if (lb.i_lower) {  // counted once: by the owner of the lower tag
+        ledger_.released += r.energy;
         local[r.mode] += 1.0;
         const double ev[kEventCols] = {
             static_cast<double>(update->ntimestep),
@@ -916,9 +1000,17 @@ void FixBondBreakable::compute_bonds(bool advance) {
     if (lb.i_lower) {
       local[0] += 1.0;
       local[3] += r.energy;
+      ledger_.damping += r.damped;
     }
   }
   if (advance) history_dirty_ = true;
+  ledger_.elastic = local[3] + stored;
+  // The bonds' own forces and torques on the owned atoms (for the ledger's work).
+  for (int i = 0; i < nlocal; ++i) {
+    double *fb = &fbond_[6 * i];
+    fb[0] = f[i][0] - fb[0], fb[1] = f[i][1] - fb[1], fb[2] = f[i][2] - fb[2];
+    fb[3] = torque[i][0] - fb[3], fb[4] = torque[i][1] - fb[4], fb[5] = torque[i][2] - fb[5];
+  }
 
   // Broken bonds become contacts (broken_contact yes): state 1, and the stored
   // shear force and moments start again from zero.

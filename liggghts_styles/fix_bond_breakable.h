@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "energy_terms.h"
 #include "fix.h"
 
 namespace LAMMPS_NS {
@@ -60,6 +61,23 @@ class FixBondBreakable : public Fix {
   // shear force (3), bending moment (3), twisting moment (1), state (0 intact
   // bond, 1 broken bond kept as a compression-only contact). Canonical frame.
   enum Column { PARTNER = 0, L0, FS, MB = FS + 3, MT = MB + 3, STATE, NCOL };
+
+  // This rank's share of the bonds' energy terms [J] (bonds computed here,
+  // counted once); summed over ranks by fix energy/ledger at its samples.
+  struct Energy {
+    mill::PowerIntegral work;   // work the bonds and contacts did on the elements
+    double elastic = 0.0;       // stored now: intact bonds and pressed contacts
+    double elastic0 = 0.0;      // stored at the start of the first run
+    double released = 0.0;      // stored in bonds at the step they broke, cumulative
+    double damping = 0.0;       // taken by the dashpots, cumulative
+    double friction = 0.0;      // taken by Coulomb slip of contacts, cumulative
+  };
+  const Energy &local_energy() const { return ledger_; }
+  // This rank's work of the bonds up to the current step, whether or not
+  // this fix's end_of_step ran yet [J].
+  double local_work_now() const;
+  // sum of end_term() over this step's bond forces (energy_terms.h) [1/s^2 J].
+  double local_end_term() const;
 
  private:
   // Parameters (SI units, see the doc page).
@@ -138,6 +156,14 @@ class FixBondBreakable : public Fix {
   bigint list_ncalls_ = -1;     // neighbor->ncalls when the list was built
   int list_nlocal_ = -1, list_nghost_ = -1;
   double list_dt_ = 0.0;        // update->dt when the list was built
+  // Energy ledger: this step's bond forces and torques on the owned atoms
+  // (6 per atom, f then torque), kept from post_force to end_of_step.
+  Energy ledger_;
+  std::vector<double> fbond_;
+  bool ledger_started_ = false;
+  bigint ledger_step_ = -1;  // the step whose power the work holds
+  double bond_power() const;  // sum of F.v + T.omega of fbond_ [W]
+
   std::vector<int> broken_;   // slots to remove this step: i, j, tag i, partner tag
   std::vector<int> contact_;  // bonds that became contacts this step: list entries
 

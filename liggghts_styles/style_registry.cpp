@@ -3,8 +3,10 @@
 #include <map>
 
 #include "fix_bond_breakable.h"
+#include "fix_energy_ledger.h"
 #include "fix_fluid_drag.h"
 #include "fix_impact_recorder.h"
+#include "fix_wall_halfspace.h"
 #include "lammps.h"
 #include "modify.h"
 
@@ -49,6 +51,10 @@ std::vector<std::string> register_mill_styles(LAMMPS_NS::LAMMPS *lmp) {
   (*fix_map)[LAMMPS_NS::FixImpactRecorder::style_name()] =
       &create_fix<LAMMPS_NS::FixImpactRecorder>;
   names.emplace_back(LAMMPS_NS::FixImpactRecorder::style_name());
+  (*fix_map)[LAMMPS_NS::FixWallHalfspace::style_name()] = &create_fix<LAMMPS_NS::FixWallHalfspace>;
+  names.emplace_back(LAMMPS_NS::FixWallHalfspace::style_name());
+  (*fix_map)[LAMMPS_NS::FixEnergyLedger::style_name()] = &create_fix<LAMMPS_NS::FixEnergyLedger>;
+  names.emplace_back(LAMMPS_NS::FixEnergyLedger::style_name());
   return names;
 }
 

@@ -1,0 +1,51 @@
+// Energy bookkeeping shared by the project's styles and fix energy/ledger.
+//
+// PowerIntegral integrates a power P(t) [W] sampled at the full steps of
+// velocity Verlet with the trapezoidal rule: the power at step n is added for
+// a whole step at the end of step n, and value() takes back the half step
+// that lies ahead of the last sample. With every force family's power summed
+// this way, the kinetic energy follows exactly, up to the integrator's shadow
+// term (docs/styles/fix_energy_ledger.md, "Exact bookkeeping").
+#ifndef MILL_ENERGY_TERMS_H
+#define MILL_ENERGY_TERMS_H
+
+namespace mill {
+
+// Sum over atoms of f.F/m + t.T/I for a family's forces f, torques t against
+// the total force F and torque T (I = 2/5 m r^2): the family's end term of
+// the trapezoidal work, times dt^2/4, that makes it its exact velocity-Verlet
+// work (docs/styles/fix_energy_ledger.md).
+inline double end_term(const double *f, const double *t, const double *ftot, const double *ttot,
+                       double mass, double radius) {
+  const double inertia = 0.4 * mass * radius * radius;
+  return (f[0] * ftot[0] + f[1] * ftot[1] + f[2] * ftot[2]) / mass +
+         (t[0] * ttot[0] + t[1] * ttot[1] + t[2] * ttot[2]) / inertia;
+}
+
+struct PowerIntegral {
+  double cum = 0.0;   // sum of P dt, with the first sample weighted 1/2 [J]
+  double last = 0.0;  // the last power sampled [W]
+  double dt = 0.0;    // the step of the last sample [s]
+
+  // The first sample (the setup of the first run): half a step ahead.
+  void start(double p, double step) {
+    cum = 0.5 * p * step;
+    last = p;
+    dt = step;
+  }
+  // The sample at the end of a step.
+  void add(double p, double step) {
+    cum += p * step;
+    last = p;
+    dt = step;
+  }
+  // The trapezoidal integral up to the last sample [J].
+  double value() const { return cum - 0.5 * last * dt; }
+  // The integral up to a sample p not yet added (read before the owner's
+  // end_of_step ran this step) [J].
+  double value_with(double p, double step) const { return cum + 0.5 * p * step; }
+};
+
+}  // namespace mill
+
+#endif
