@@ -126,6 +126,7 @@ struct FixBondBreakable::BondResult {
   double strength;  // shear strength at this normal stress [Pa]
   double energy;    // elastic energy stored in the bond [J]
   double stretch;   // L - L0 [m] (< 0: compressed)
+  double released;  // what a bond that breaks now takes with it [J] (advance only)
   double damped;    // taken this step by the dashpots [J] (advance only)
   double slipped;   // taken this step by Coulomb slip of a contact [J] (advance only)
   Vec3 centre;      // bond centre (contact point)
@@ -667,10 +668,7 @@ inline void FixBondBreakable::evaluate_bond(const AtomArrays &at, ListedBond &bo
     out.mode = 1;
   else if (out.tau > out.strength)
     out.mode = 2;
-  if (out.mode != 0) {
-    out.centre = xa + m.ra;
-    if (advance) return;  // breaks now: exerts no force from this step on
-  }
+  if (out.mode != 0) out.centre = xa + m.ra;  // breaks now: exerts no force from this step on
 
   // Force on b: spring part plus optional viscous part (fraction of critical
   // damping of the two-body normal / shear oscillator; not part of the stress).
@@ -685,6 +683,18 @@ inline void FixBondBreakable::evaluate_bond(const AtomArrays &at, ListedBond &bo
   const Vec3 mom = mb + mt * n;
   out.ta = cross(m.ra, out.fa) - mom;
   out.tb = cross(m.rb, fb) + mom;
+  if (advance && out.mode != 0) {
+    // Released: the energy held now plus the half step of work the bond
+    // would still have done, f . dx / 2 with the half-step velocities (its
+    // force ends between two steps; with this the ledger closes exactly for
+    // a linear spring). A contact left behind keeps its normal push.
+    const bool keeps_push = broken_contact_ && stretch < 0.0;
+    const Vec3 fgone = keeps_push ? fs : fb;
+    const Vec3 tga = keeps_push ? cross(m.ra, -fs) - mom : out.ta;
+    const Vec3 tgb = keeps_push ? cross(m.rb, fs) + mom : out.tb;
+    const double p_half = dot(fgone, m.vrel_ab) + dot(tga, m.wa) + dot(tgb, m.wb);
+    out.released = out.energy - (keeps_push ? 0.5 * fn * stretch : 0.0) + 0.5 * p_half * dt;
+  }
 }
 
 // A contact: a broken bond kept (broken_contact yes) or a pair left unbonded
@@ -972,7 +982,7 @@ void FixBondBreakable::compute_bonds(bool advance) {
 
     if (advance && r.mode != 0) {
       if (lb.i_lower) {  // counted once: by the owner of the lower tag
-        ledger_.released += r.energy;
+        ledger_.released += r.released;
         local[r.mode] += 1.0;
         const double ev[kEventCols] = {
             static_cast<double>(update->ntimestep),

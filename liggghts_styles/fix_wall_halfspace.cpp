@@ -158,7 +158,11 @@ void FixWallHalfspace::compute_contacts(bool advance) {
     const double delta = radius[i] - s;
     double *sh = shear_[i];
     if (delta <= 0.0) {  // no contact: the tangential spring is released
-      if (advance) sh[0] = sh[1] = sh[2] = 0.0;
+      if (advance) {
+        // What it still held is lost with it (the ledger counts it as friction).
+        energy_.friction += 0.5 * sh[3] * (sh[0] * sh[0] + sh[1] * sh[1]);
+        sh[0] = sh[1] = sh[2] = sh[3] = 0.0;
+      }
       continue;
     }
     const double r = radius[i], m = rmass[i];
@@ -182,6 +186,12 @@ void FixWallHalfspace::compute_contacts(bool advance) {
     // Mindlin tangential spring with Coulomb's cap (tangential_model_history.h).
     double trial[3] = {sh[0], sh[1], 0.0};
     if (advance) {
+      // The Mindlin spring keeps its displacement while its stiffness follows
+      // the overlap, so k_t |s|^2 / 2 changes with no work done: energy the
+      // incremental law makes (loading) or loses (unloading). The ledger
+      // counts it with the tangential losses; a new contact starts at k_t.
+      if (sh[3] > 0.0) energy_.friction -= 0.5 * (kt - sh[3]) * (sh[0] * sh[0] + sh[1] * sh[1]);
+      sh[3] = kt;
       trial[0] += vt[0] * dt;
       trial[1] += vt[1] * dt;
     }
@@ -280,44 +290,47 @@ void FixWallHalfspace::local_work_now(double &work, double &damping) const {
 // ---- per-atom tangential spring: 3 columns, same order everywhere ----
 
 void FixWallHalfspace::grow_arrays(int nmax) {
-  memory->grow(shear_, nmax, 3, "wall/halfspace:shear");
-  for (int i = nmax_; i < nmax; ++i) shear_[i][0] = shear_[i][1] = shear_[i][2] = 0.0;
+  memory->grow(shear_, nmax, kCols, "wall/halfspace:shear");
+  for (int i = nmax_; i < nmax; ++i)
+    for (int d = 0; d < kCols; ++d) shear_[i][d] = 0.0;
   nmax_ = nmax;
 }
 
 void FixWallHalfspace::copy_arrays(int i, int j, int /*delflag*/) {
-  for (int d = 0; d < 3; ++d) shear_[j][d] = shear_[i][d];
+  for (int d = 0; d < kCols; ++d) shear_[j][d] = shear_[i][d];
 }
 
-void FixWallHalfspace::set_arrays(int i) { shear_[i][0] = shear_[i][1] = shear_[i][2] = 0.0; }
+void FixWallHalfspace::set_arrays(int i) {
+  for (int d = 0; d < kCols; ++d) shear_[i][d] = 0.0;
+}
 
 int FixWallHalfspace::pack_exchange(int i, double *buf) {
-  for (int d = 0; d < 3; ++d) buf[d] = shear_[i][d];
-  return 3;
+  for (int d = 0; d < kCols; ++d) buf[d] = shear_[i][d];
+  return kCols;
 }
 
 int FixWallHalfspace::unpack_exchange(int nlocal, double *buf) {
-  for (int d = 0; d < 3; ++d) shear_[nlocal][d] = buf[d];
-  return 3;
+  for (int d = 0; d < kCols; ++d) shear_[nlocal][d] = buf[d];
+  return kCols;
 }
 
 int FixWallHalfspace::pack_restart(int i, double *buf) {
-  buf[0] = 4;  // values of this fix, this one included (LAMMPS convention)
-  for (int d = 0; d < 3; ++d) buf[1 + d] = shear_[i][d];
-  return 4;
+  buf[0] = kCols + 1;  // values of this fix, this one included (LAMMPS convention)
+  for (int d = 0; d < kCols; ++d) buf[1 + d] = shear_[i][d];
+  return kCols + 1;
 }
 
 void FixWallHalfspace::unpack_restart(int nlocal, int nth) {
   double **extra = atom->extra;
   int m = 0;
   for (int k = 0; k < nth; ++k) m += static_cast<int>(extra[nlocal][m]);
-  for (int d = 0; d < 3; ++d) shear_[nlocal][d] = extra[nlocal][m + 1 + d];
+  for (int d = 0; d < kCols; ++d) shear_[nlocal][d] = extra[nlocal][m + 1 + d];
 }
 
-int FixWallHalfspace::size_restart(int /*nlocal*/) { return 4; }
-int FixWallHalfspace::maxsize_restart() { return 4; }
+int FixWallHalfspace::size_restart(int /*nlocal*/) { return kCols + 1; }
+int FixWallHalfspace::maxsize_restart() { return kCols + 1; }
 
 double FixWallHalfspace::memory_usage() {
-  return static_cast<double>(nmax_) * 3 * sizeof(double) +
+  return static_cast<double>(nmax_) * kCols * sizeof(double) +
          static_cast<double>(touches_.capacity()) * sizeof(Touch);
 }

@@ -51,7 +51,7 @@ class FixWallHalfspace : public Fix {
     double elastic = 0.0;         // stored in the contacts now (normal + tangential springs)
     double elastic0 = 0.0;        // stored at the start of the first run
     mill::PowerIntegral damping;  // dissipated by the normal and tangential dashpots
-    double friction = 0.0;        // dissipated by Coulomb sliding, cumulative
+    double friction = 0.0;        // dissipated by Coulomb sliding and the spring's stiffness change, cumulative
     double max_overlap = 0.0;     // largest overlap / element radius so far [-]
   };
   const Energy &local_energy() const { return energy_; }
@@ -81,7 +81,9 @@ class FixWallHalfspace : public Fix {
 
   double yeff_ = 0.0, geff_ = 0.0, beta_ = 0.0;  // set in init()
 
-  // Per-atom tangential spring displacement (3 columns), migrates with atoms.
+  // Per-atom tangential spring: displacement (3 columns) and the stiffness
+  // k_t it had at the last step (4th column), migrates with atoms.
+  static constexpr int kCols = 4;
   double **shear_ = nullptr;
   int nmax_ = 0;
 

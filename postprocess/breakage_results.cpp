@@ -74,6 +74,9 @@ const std::vector<Column>& Columns() {
       MakeColumn("intact_bonds", "1", &S::intact_bonds),
       MakeColumn("element_d_rel_max", "1", &S::element_d_rel_max),
       MakeColumn("t10_resolved", "1", &S::t10_resolved),
+      MakeColumn("comminution_efficiency", "1", &S::comminution_efficiency),
+      MakeColumn("ledger_residual_fraction", "1", &S::ledger_residual_fraction),
+      MakeColumn("max_element_speed_m_s", "m/s", &S::max_element_speed_m_s),
   };
   return columns;
 }
@@ -292,6 +295,51 @@ void WriteImpactGroup(hid_t impacts, const ImpactResult& r) {
                   "equal-volume sphere of the solid: d = (6 m / (pi rho))^(1/3)");
 }
 
+// An impact group's summary attributes. Columns past the required ones may be
+// missing (a file from before they existed): they keep the field's default.
+ImpactSummary ReadSummaryAttrs(hid_t g, const std::string& where) {
+  ImpactSummary s;
+  const auto& cols = Columns();
+  for (std::size_t c = 0; c < cols.size(); ++c) {
+    if (c >= kRequiredColumns && H5Aexists(g, cols[c].name) <= 0) continue;
+    cols[c].set(s, ReadNumberAttr(g, cols[c].name, where));
+  }
+  return s;
+}
+
+// The names of the links in a group, in name order.
+std::vector<std::string> LinkNames(hid_t group, const std::string& where) {
+  H5G_info_t info;
+  H5Check(H5Gget_info(group, &info), fmt::format("{}: group info", where));
+  std::vector<std::string> names;
+  for (hsize_t k = 0; k < info.nlinks; ++k) {
+    const ssize_t len = H5Lget_name_by_idx(group, ".", H5_INDEX_NAME, H5_ITER_INC, k, nullptr, 0,
+                                           H5P_DEFAULT);
+    if (len < 0) throw PostError(fmt::format("{}: cannot list", where));
+    std::string name(static_cast<std::size_t>(len) + 1, '\0');
+    H5Lget_name_by_idx(group, ".", H5_INDEX_NAME, H5_ITER_INC, k, name.data(), name.size(),
+                       H5P_DEFAULT);
+    name.resize(static_cast<std::size_t>(len));
+    names.push_back(name);
+  }
+  return names;
+}
+
+// An impact file's /energy (the ledger of its one impact) into the merged
+// file's group of that impact, /impacts/<name>/energy.
+void CopyEnergyGroup(hid_t in, const std::string& in_path, const std::vector<std::string>& names,
+                     hid_t out_impacts) {
+  if (H5Lexists(in, "energy", H5P_DEFAULT) <= 0) return;
+  if (names.size() != 1) {
+    throw PostError(fmt::format(
+        "{}: /energy beside {} impacts: a ledger belongs to a file of one impact (impact.h5)",
+        in_path, names.size()));
+  }
+  const std::string to = names[0] + "/energy";
+  H5Check(H5Ocopy(in, "energy", out_impacts, to.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+          fmt::format("copying /energy from {} to /impacts/{}", in_path, to));
+}
+
 // Creates (or truncates) an HDF5 file for writing.
 hid_t CreateTmpFile(const std::string& tmp) {
   const hid_t file = H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
@@ -373,6 +421,9 @@ ImpactResult AnalyseImpact(const std::vector<Element>& elements, const std::vect
   s.specific_energy_kWh_t = s.specific_energy_J_kg / kJoulePerKgPerKWhPerTonne;
   s.t10_percent = T10Percent(d_rel, mass);
   r.fraction_mass = SizeFractionMass(d_rel, mass, spec.fraction_edges);
+  std::vector<double> diameters;
+  for (const Fragment& f : r.fragments) diameters.push_back(f.diameter);
+  r.new_surface_m2 = NewSurfaceArea(diameters, d_ref);
 
   for (const Element& e : elements) {
     s.element_d_rel_max = std::max(
@@ -601,16 +652,9 @@ void MergeBreakageH5Files(const std::string& path, const std::vector<std::string
         throw PostError(fmt::format("{}: no /impacts group (not a breakage.h5?)", in_path));
       }
       H5Id in_impacts(H5Gopen2(in, "impacts", H5P_DEFAULT), H5Gclose, "open /impacts");
-      H5G_info_t info;
-      H5Check(H5Gget_info(in_impacts, &info), "group info");
-      for (hsize_t k = 0; k < info.nlinks; ++k) {
-        const ssize_t len = H5Lget_name_by_idx(in_impacts, ".", H5_INDEX_NAME, H5_ITER_INC, k,
-                                               nullptr, 0, H5P_DEFAULT);
-        if (len < 0) throw PostError(fmt::format("{}: cannot list /impacts", in_path));
-        std::string name(static_cast<std::size_t>(len) + 1, '\0');
-        H5Lget_name_by_idx(in_impacts, ".", H5_INDEX_NAME, H5_ITER_INC, k, name.data(), name.size(),
-                           H5P_DEFAULT);
-        name.resize(static_cast<std::size_t>(len));
+      const std::vector<std::string> names =
+          LinkNames(in_impacts, fmt::format("{}:/impacts", in_path));
+      for (const std::string& name : names) {
         auto [it, fresh] = source_of.emplace(name, in_path);
         if (!fresh) {
           throw PostError(fmt::format("impact {} is in both {} and {}", name, it->second, in_path));
@@ -619,11 +663,11 @@ void MergeBreakageH5Files(const std::string& path, const std::vector<std::string
             H5Ocopy(in_impacts, name.c_str(), out_impacts, name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
             fmt::format("copying /impacts/{} from {}", name, in_path));
         H5Id g(H5Gopen2(in_impacts, name.c_str(), H5P_DEFAULT), H5Gclose, "open impact");
-        ImpactSummary s;
-        const std::string where = fmt::format("{}:/impacts/{}", in_path, name);
-        for (const Column& c : Columns()) c.set(s, ReadNumberAttr(g, c.name, where));
-        rows.push_back(s);
+        rows.push_back(ReadSummaryAttrs(g, fmt::format("{}:/impacts/{}", in_path, name)));
       }
+      // The ledger is copied per impact, not skipped: breakage.h5 holds every
+      // impact's time series under its own group.
+      CopyEnergyGroup(in, in_path, names, out_impacts);
     }
     WriteSummaryGroup(out, rows);
   } catch (...) {
@@ -673,6 +717,34 @@ void WriteJkFitH5(const std::string& path, const std::vector<JkFitRecord>& recor
       scalar("A_times_b_max", r.fit.ab->max, "% t/kWh");
     }
     WriteNumberAttr(g, "repeats_fitted", r.fit.n_repeats_fitted, true);
+  }
+}
+
+// The ledger's columns as /energy of an existing file.
+void WriteEnergyLedgerH5(const std::string& path, const EnergyLedger& ledger) {
+  H5Quiet quiet;
+  const hid_t raw = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  if (raw < 0) throw PostError(fmt::format("{}: cannot open as HDF5 for writing", path));
+  H5Id file(raw, H5Fclose, "open");
+  if (H5Lexists(file, "energy", H5P_DEFAULT) > 0)
+    H5Check(H5Ldelete(file, "energy", H5P_DEFAULT), "delete /energy");
+  H5Id g(MakeGroup(file, "energy"), H5Gclose, "group /energy");
+  WriteStringAttr(g, "balance",
+                  "input + work_other = ke_trans + ke_rot + numerical + bond_elastic + "
+                  "bond_released + bond_damping + bond_friction + wall_elastic + wall_damping + "
+                  "wall_friction + contact_elastic + contact_dissipated + residual "
+                  "(docs/styles/fix_energy_ledger.md)");
+  WriteStringAttr(g, "source", ledger.path);
+  const std::vector<hsize_t> dims = {ledger.rows()};
+  for (std::size_t c = 0; c < ledger.columns.size(); ++c) {
+    const std::string& name = ledger.columns[c];
+    if (name == "step") {
+      std::vector<long long> steps;
+      for (double v : ledger.values[c]) steps.push_back(std::llround(v));
+      WriteDataset(g, name.c_str(), steps, dims, "1");
+    } else {
+      WriteDataset(g, name.c_str(), ledger.values[c], dims, LedgerUnit(name).c_str());
+    }
   }
 }
 

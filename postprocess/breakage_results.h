@@ -4,10 +4,12 @@
 // LIGGGHTS run, appends the CSV rows, and merges the HDF5 at the end.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "postprocess/distributions.h"
+#include "postprocess/energy_ledger.h"
 #include "postprocess/fragments.h"
 #include "postprocess/jk_fit.h"
 
@@ -54,6 +56,10 @@ struct ImpactSummary {
   long long intact_bonds = 0;
   double element_d_rel_max = 0.0;  // coarsest single element, d/D
   bool t10_resolved = true;        // every element is finer than D/10
+  // From the run's energy ledger (energy_ledger.h); NaN when there is none.
+  double comminution_efficiency = std::numeric_limits<double>::quiet_NaN();    // at the end
+  double ledger_residual_fraction = std::numeric_limits<double>::quiet_NaN();  // at the end, signed
+  double max_element_speed_m_s = std::numeric_limits<double>::quiet_NaN();     // over the run
 };
 
 // Everything known about one impact.
@@ -63,6 +69,7 @@ struct ImpactResult {
   std::vector<double> fraction_edges;  // d/D
   std::vector<double> fraction_mass;   // mass fraction per size fraction, sums to 1
   std::vector<std::string> warnings;   // e.g. t10 cannot resolve
+  double new_surface_m2 = 0.0;         // sphere-equivalent surface created (NewSurfaceArea)
 };
 
 // Analyses one impact from elements and intact bonds (duplicate bonds, in
@@ -116,8 +123,16 @@ std::string ImpactGroupName(const ImpactConditions& c);
 void WriteBreakageH5(const std::string& path, const std::vector<ImpactResult>& results);
 
 // Merges per-impact breakage.h5 files into one: copies every /impacts group
-// and rebuilds /summary. Writes path.tmp, then renames.
+// and rebuilds /summary. An input's /energy (its one impact's ledger,
+// WriteEnergyLedgerH5) is copied to /impacts/<name>/energy. Summary
+// attributes past the required columns may be missing (files from before
+// they existed: NaN, or the field's default). Writes path.tmp, then renames.
 void MergeBreakageH5Files(const std::string& path, const std::vector<std::string>& inputs);
+
+// Adds the group /energy to an existing file of one impact (impact.h5): one
+// dataset per ledger column, each with its `unit` attribute (LedgerUnit), and
+// the attribute `balance`. Replaces /energy if present.
+void WriteEnergyLedgerH5(const std::string& path, const EnergyLedger& ledger);
 
 // The JK fit of one group of impacts (one angle, or all conditions pooled),
 // with every point it considered: `used` is 1 where t10 was resolved.

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <map>
 
 #include "postprocess/fragments.h"
@@ -195,6 +196,24 @@ CriticalVelocity FindCriticalVelocity(const std::vector<SweepPoint>& points, dou
     }
   }
   return out;
+}
+
+// The mean curve at one velocity, linear between sweep velocities.
+std::optional<double> MeanCurveAt(const std::vector<SweepPoint>& points, double velocity) {
+  std::map<double, std::pair<double, int>> by_v;  // velocity -> (sum, count)
+  for (const SweepPoint& p : points) {
+    auto& acc = by_v[p.velocity_m_s];
+    acc.first += p.value;
+    acc.second += 1;
+  }
+  const auto above = by_v.lower_bound(velocity);
+  if (above == by_v.end()) return std::nullopt;
+  const double y1 = above->second.first / above->second.second;
+  if (above->first == velocity) return y1;
+  if (above == by_v.begin()) return std::nullopt;
+  const auto below = std::prev(above);
+  const double y0 = below->second.first / below->second.second;
+  return y0 + (y1 - y0) * (velocity - below->first) / (above->first - below->first);
 }
 
 }  // namespace mill::post

@@ -75,4 +75,10 @@ struct CriticalVelocity {
 // stddev is the sample standard deviation (n-1), absent for fewer than two.
 CriticalVelocity FindCriticalVelocity(const std::vector<SweepPoint>& points, double threshold);
 
+// The repeat-averaged curve of a sweep's points read at `velocity`: values at
+// one velocity are averaged, and the curve is linear between the velocities
+// around it. nullopt outside the swept velocities or without points. Used for
+// a quantity at the critical velocity (the comminution efficiency there).
+std::optional<double> MeanCurveAt(const std::vector<SweepPoint>& points, double velocity);
+
 }  // namespace mill::post

@@ -7,6 +7,10 @@ and writes, per impact angle, averaged over repeats with the min/max spread:
   pieces_vs_velocity.png      single-element and multi-element pieces vs speed
   largest_vs_velocity.png     largest piece mass fraction vs speed, with the
                               threshold and the critical velocity
+  comminution_efficiency_vs_velocity.png
+                              comminution efficiency (bond_released over the
+                              energy given, from each impact's energy ledger)
+                              vs speed, when summary.csv has the column
   passing_vs_size.png         cumulative % passing against size in mm (log
                               axis) per condition, from size_distributions.csv
                               (written by the breakage stage), with --passing
@@ -39,6 +43,7 @@ from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 SUMMARY_NEEDED = ("velocity_m_s", "angle_deg", "repeat", "n_single", "n_multi",
                   "largest_mass_fraction")
+EFFICIENCY = "comminution_efficiency"
 PASSING_NEEDED = ("velocity_m_s", "angle_deg", "sieve_mm", "passing_percent", "passing_percent_min",
                   "passing_percent_max")
 
@@ -170,6 +175,36 @@ def plot_largest(by_angle, critical, threshold, path):
     save(fig, path)
 
 
+def plot_efficiency(by_angle, critical, path):
+    """Comminution efficiency (%) vs speed, mean and min-max band over repeats,
+    with the critical speed of the largest piece marked."""
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for angle, rows in sorted(by_angle.items(), key=lambda kv: -1 if kv[0] is None else kv[0]):
+        v, mean, lo, hi = stats_by_velocity(rows, EFFICIENCY)
+        line, = ax.plot(v, 100 * mean, "o-", label=f"mean, {angle_label(angle)}")
+        ax.fill_between(v, 100 * lo, 100 * hi, color=line.get_color(), alpha=0.2)
+        c = critical.get(angle)
+        if c and c["critical_velocity_m_s"] is not None:
+            ax.axvline(c["critical_velocity_m_s"], color=line.get_color(), ls=":",
+                       label=f"critical {c['critical_velocity_m_s']:.1f} m/s (largest piece)")
+    ax.set_xlabel("impact speed [m/s]")
+    ax.set_ylabel("comminution efficiency [%]")
+    ax.set_ylim(bottom=0)
+    ax.set_title("Energy into broken bonds / energy given (band: min-max over repeats)", fontsize=10)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    save(fig, path)
+
+
+def has_column(path, column):
+    """True when the CSV's header names the column."""
+    try:
+        with open(path, newline="") as f:
+            return column in (csv.DictReader(f).fieldnames or [])
+    except OSError as e:
+        sys.exit(f"{path}: cannot read ({e.strerror})")
+
+
 def plot_passing(passing, velocities, path):
     """Cumulative % passing against size in mm (log axis) per condition, the
     repeat-averaged curve with its min-max band; P80 marked by a line."""
@@ -241,6 +276,19 @@ def main(argv=None):
 
     plot_pieces(by_angle, os.path.join(a.out, "pieces_vs_velocity.png"))
     plot_largest(by_angle, critical, a.threshold, os.path.join(a.out, "largest_vs_velocity.png"))
+    # Impacts without a ledger (NaN efficiency) are left out; with none, no plot.
+    efficiency_png = os.path.join(a.out, "comminution_efficiency_vs_velocity.png")
+    with_ledger = []
+    if has_column(a.summary, EFFICIENCY):
+        with_ledger = [r for r in read_csv(a.summary, SUMMARY_NEEDED + (EFFICIENCY,))
+                       if math.isfinite(r[EFFICIENCY])]
+    if with_ledger:
+        by_angle_eff = defaultdict(list)
+        for r in with_ledger:
+            by_angle_eff[None if a.pool_angles else r["angle_deg"]].append(r)
+        plot_efficiency(by_angle_eff, critical, efficiency_png)
+    elif os.path.exists(efficiency_png):
+        os.remove(efficiency_png)
     if a.passing:
         passing = read_csv(a.passing, PASSING_NEEDED)
         if not passing:

@@ -63,6 +63,34 @@ std::string rpm_words(const std::string& key) { return key.substr(3) + " rpm"; }
 
 std::string percent(double fraction) { return fmt::format("{:.0f}%", 100 * fraction); }
 
+// A fraction as a percentage with about three significant figures.
+std::string percent3(double fraction) { return g3(100 * fraction) + "%"; }
+
+// The comminution efficiency per angle (breakage/comminution_efficiency.json):
+// at the critical speed, with its range over the sweep, and the ledgers'
+// largest residual (group and brief are set by the caller's add).
+std::vector<HeadlineRow> efficiency_rows(const json& eff) {
+  std::vector<HeadlineRow> rows;
+  if (!eff.is_array()) return rows;
+  for (const auto& e : eff) {
+    if (!num(pick(e, "mean"))) continue;
+    const std::string at = num(pick(e, "angle_deg")) ? fmt::format(", {:g} deg", d(e.at("angle_deg"))) : "";
+    const std::string range = num(pick(e, "min")) && num(pick(e, "max"))
+                                  ? fmt::format("{}-{} over the sweep", percent3(d(e.at("min"))), percent3(d(e.at("max"))))
+                                  : "";
+    rows.push_back({"", "comminution efficiency at the critical speed" + at,
+                    num(pick(e, "at_critical_speed"))
+                        ? fmt::format("{} of the energy given went into broken bonds ({})",
+                                      percent3(d(e.at("at_critical_speed"))), range)
+                        : "critical speed not reached; " + range,
+                    true});
+    if (num(pick(e, "ledger_residual_fraction_max")))
+      rows.push_back({"", "energy ledger residual, largest of the impacts" + at,
+                      percent3(d(e.at("ledger_residual_fraction_max"))) + " of the energy given", false});
+  }
+  return rows;
+}
+
 }  // namespace
 
 const std::vector<HeadlineGroup>& headline_groups() {
@@ -146,6 +174,18 @@ json headline_json(const fs::path& run, Problems* problems) {
                    {"max_m_s", pick(e, "max_m_s")},
                    {"largest_fraction_threshold", pick(e, "threshold")}});
     h["breakage"]["critical_speed"] = c;
+  }
+  const auto eff = read_json(run / "breakage" / "comminution_efficiency.json", problems);
+  if (eff.is_array()) {
+    json c = json::array();
+    for (const auto& e : eff) {
+      json x = json::object();
+      for (const char* k : {"angle_deg", "critical_velocity_m_s", "at_critical_speed", "mean", "min", "max",
+                            "impacts", "ledger_residual_fraction_max"})
+        x[k] = pick(e, k);
+      c.push_back(x);
+    }
+    h["breakage"]["comminution_efficiency"] = c;
   }
   const auto jk = read_json(run / "breakage" / "jk_fit.json", problems);
   if (jk.is_array()) {
@@ -335,6 +375,8 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
       }
       add(3, what, v);
     }
+  for (const auto& e : efficiency_rows(pick(pick(h, "breakage"), "comminution_efficiency")))
+    add(3, e.what, e.value, e.brief);
   const json jk = pick(pick(h, "breakage"), "jk");
   json card = nullptr;
   if (jk.is_array())

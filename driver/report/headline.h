@@ -16,7 +16,8 @@ namespace mill::report {
 
 // The headline numbers of the run folder `run` (report/summary.json's
 // "headline"): flow and transport per rotor speed ("rpm2000"), calibration,
-// breakage (critical speed, JK fit) and the mill product per rotor speed.
+// breakage (critical speed, comminution efficiency at it, JK fit) and the
+// mill product per rotor speed.
 // A stage that has not run is absent.
 // A JSON file that does not parse is left out and added to `problems`.
 nlohmann::json headline_json(const std::filesystem::path& run, Problems* problems = nullptr);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "engine/liggghts.h"
@@ -44,8 +45,107 @@ nlohmann::json impact_base_inputs(const StageContext& ctx) {
   // 4: bond/breakable with the signed tension criterion, the moment factor and
   // the exact critical step (Nov 2026): earlier results are not comparable.
   // 5: the time step also bounded by the impact speed (issue 15).
-  base["deck_version"] = 5;
+  // 6: the one-sided surface (wall/halfspace), the energy ledger and the
+  // bonds' midpoint increments.
+  base["deck_version"] = 6;
   return base;
+}
+
+// The new surface of the impact's pieces and the energy released by broken
+// bonds per unit of it (null for an intact lump), into result.json's `energy`.
+void add_new_surface(nlohmann::json& energy, const LumpRunResult& a) {
+  const auto per_surface =
+      post::EnergyPerNewSurface(a.energy.bond_released_J, a.result.new_surface_m2);
+  energy["new_surface_m2"] = a.result.new_surface_m2;
+  energy["energy_per_new_surface_J_m2"] =
+      per_surface ? nlohmann::json(*per_surface) : nlohmann::json(nullptr);
+  energy["definitions"]["new_surface_m2"] =
+      "sum over pieces of pi d^2 (d: equal-volume diameter of the piece's solid) minus that of "
+      "the whole lump";
+  energy["definitions"]["energy_per_new_surface_J_m2"] = "bond_released_J / new_surface_m2";
+}
+
+// <out_dir>/energy_ledger.png: the impact's ledger over time, stacked
+// (postprocess/plot_energy_ledger.py, matplotlib, Debian's python3).
+void plot_energy_ledger(StageContext& ctx, const fs::path& out_dir, double velocity, double angle,
+                        int repeat, const std::string& label) {
+  engine::Command c;
+  c.argv = {"/usr/bin/python3",
+            (ctx.cfg.project_dir / "postprocess" / "plot_energy_ledger.py").string(),
+            "--ledger",
+            (out_dir / "energy_ledger.csv").string(),
+            "--out",
+            (out_dir / "energy_ledger.png").string(),
+            "--title",
+            fmt::format("{:g} m/s at {:g} deg, repeat {}", velocity, angle, repeat)};
+  c.cwd = out_dir;
+  c.log = out_dir / "energy_ledger_plot.log";
+  c.job = "breakage/" + label + " ledger plot";
+  ctx.runner.run(c);
+}
+
+// The comminution efficiency of the impacts of one entry of
+// critical_velocity.json `c` (an angle, or all conditions pooled): on the
+// repeat-averaged curve at the critical speed (null when the sweep does not
+// reach it), mean, min and max over the impacts, and the largest |residual|
+// of their ledgers as a share of the energy given.
+nlohmann::json efficiency_entry(const std::vector<post::ImpactSummary>& rows, const nlohmann::json& c) {
+  std::vector<post::SweepPoint> pts;
+  double residual = 0, sum = 0, lo = INFINITY, hi = -INFINITY;
+  for (const auto& s : rows) {
+    if (!(c["angle_deg"].is_null() || s.angle_deg == c["angle_deg"].get<double>())) continue;
+    if (!std::isfinite(s.comminution_efficiency)) continue;
+    pts.push_back({s.velocity_m_s, s.repeat, s.comminution_efficiency});
+    sum += s.comminution_efficiency;
+    lo = std::min(lo, s.comminution_efficiency);
+    hi = std::max(hi, s.comminution_efficiency);
+    if (std::isfinite(s.ledger_residual_fraction)) residual = std::max(residual, std::abs(s.ledger_residual_fraction));
+  }
+  const nlohmann::json none = nullptr;
+  std::optional<double> at;
+  if (c["critical_velocity_m_s"].is_number()) at = post::MeanCurveAt(pts, c["critical_velocity_m_s"].get<double>());
+  return {{"angle_deg", c["angle_deg"]},
+          {"critical_velocity_m_s", c["critical_velocity_m_s"]},
+          {"impacts", pts.size()},
+          {"at_critical_speed", at ? nlohmann::json(*at) : none},
+          {"mean", pts.empty() ? none : nlohmann::json(sum / pts.size())},
+          {"min", pts.empty() ? none : nlohmann::json(lo)},
+          {"max", pts.empty() ? none : nlohmann::json(hi)},
+          {"ledger_residual_fraction_max", pts.empty() ? none : nlohmann::json(residual)},
+          {"definition",
+           "bond_released_J / (input_J + max(work_other_J, 0)) at the end of each impact (its energy ledger); at "
+           "the critical speed: the repeat-averaged curve, linear between sweep speeds"}};
+}
+
+// breakage/comminution_efficiency.json: efficiency_entry per entry of
+// critical_velocity.json.
+void write_comminution_efficiency(StageContext& ctx, const std::vector<post::ImpactSummary>& rows,
+                                  const nlohmann::json& crit) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& c : crit) {
+    out.push_back(efficiency_entry(rows, c));
+    const auto& e = out.back();
+    if (e["at_critical_speed"].is_number())
+      ctx.progress.info(fmt::format("[breakage] comminution efficiency at the critical speed {:.1f} m/s: {:.2g}%",
+                                    c["critical_velocity_m_s"].get<double>(),
+                                    100 * e["at_critical_speed"].get<double>()));
+  }
+  jobs::atomic_write(ctx.stage_dir / "comminution_efficiency.json", out.dump(2) + "\n");
+}
+
+// plots/energy_ledger_fastest.png: the energy ledger plot of the fastest
+// impact of the sweep (the first repeat of it), for the report.
+void publish_fastest_ledger_plot(StageContext& ctx, const std::vector<post::ImpactSummary>& rows,
+                                 const std::vector<fs::path>& row_dirs) {
+  const auto fastest = std::max_element(rows.begin(), rows.end(), [](const auto& a, const auto& b) {
+    return a.velocity_m_s < b.velocity_m_s;
+  });
+  if (fastest == rows.end()) return;
+  const fs::path from = row_dirs[static_cast<size_t>(fastest - rows.begin())] / "energy_ledger.png";
+  const fs::path to = ctx.stage_dir / "plots" / "energy_ledger_fastest.png";
+  fs::create_directories(to.parent_path());
+  fs::copy_file(from, to.string() + ".tmp", fs::copy_options::overwrite_existing);
+  fs::rename(to.string() + ".tmp", to);
 }
 
 }  // namespace
@@ -58,17 +158,25 @@ nlohmann::json impact_inputs(const StageContext& ctx, double velocity, double an
   return in;
 }
 
-std::string damaged_impact_outputs(const fs::path& dir) { return damaged_lump_outputs(dir); }
+std::string damaged_impact_outputs(const fs::path& dir) {
+  if (auto r = damaged_lump_outputs(dir); !r.empty()) return r;
+  return jobs::check_file(dir / "energy_ledger.png");
+}
 
 std::string impact_line(const nlohmann::json& r) {
   auto num = [&](const char* k) { return r.contains(k) && r[k].is_number() ? r[k].get<double>() : NAN; };
+  const nlohmann::json e = r.value("energy", nlohmann::json::object());
+  const std::string efficiency =
+      e.contains("comminution_efficiency") && e["comminution_efficiency"].is_number()
+          ? fmt::format(", comminution efficiency {:.2g}%", 100 * e["comminution_efficiency"].get<double>())
+          : "";
   return fmt::format(
       "{:g} m/s at {:g} deg: {} pieces ({} single, {} multi), largest {:.1f}%, single-element mass {:.1f}%, "
-      "broken bonds {:.1f}%, {:.3g} kWh/t, t10 {:.1f}%{} [{:.1f} s]",
+      "broken bonds {:.1f}%, {:.3g} kWh/t, t10 {:.1f}%{}{} [{:.1f} s]",
       num("velocity_m_s"), num("angle_deg"), num("n_pieces"), num("n_single"), num("n_multi"),
       100 * num("largest_mass_fraction"), 100 * num("single_mass_fraction"), 100 * num("broken_bond_fraction"),
       num("specific_energy_kWh_t"), num("t10_percent"), r.value("t10_resolved", true) ? "" : " (unresolved)",
-      num("wall_seconds"));
+      efficiency, num("wall_seconds"));
 }
 
 std::string BreakageStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
@@ -200,8 +308,10 @@ std::string run_impact(StageContext& ctx, double velocity, double angle, int rep
 
   // Outputs, each complete or absent. The raw run stays for inspection
   // (dumps for ParaView, logs); it is small next to the VTK dumps a user asks for.
-  const nlohmann::json j = lump_result_json(lr, a.result, res.seconds);
+  nlohmann::json j = lump_result_json(lr, a, res.seconds);
+  add_new_surface(j["energy"], a);
   write_lump_outputs(out_dir, a, j);
+  plot_energy_ledger(ctx, out_dir, velocity, angle, repeat, label);
   return impact_line(j);
 }
 
@@ -224,12 +334,16 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& all_
   const jobs::JobStore store(dir);
   std::vector<std::string> h5;
   std::vector<post::ImpactSummary> rows;
+  std::vector<fs::path> row_dirs;  // the job folder of each row
   std::vector<post::FractionRow> fraction_rows;
   std::string fractions_text;
   for (const auto& j : jobs) {
     const fs::path jd = store.job_dir(j.label);
     h5.push_back((jd / "impact.h5").string());
-    for (const auto& s : post::ReadSummaryCsv((jd / "summary.csv").string())) rows.push_back(s);
+    for (const auto& s : post::ReadSummaryCsv((jd / "summary.csv").string())) {
+      rows.push_back(s);
+      row_dirs.push_back(jd);
+    }
     for (const auto& f : post::ReadFractionsCsv((jd / "fractions.csv").string())) {
       fractions_text += post::FractionsCsvLine(f) + "\n";
       fraction_rows.push_back(f);
@@ -276,6 +390,7 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& all_
                                         100 * thr));
   }
   jobs::atomic_write(dir / "critical_velocity.json", crit.dump(2) + "\n");
+  write_comminution_efficiency(ctx, rows, crit);
 
   // In the mill engineer's terms: JK A and b, passing curves in mm.
   write_size_distributions(ctx, fraction_rows);
@@ -291,10 +406,12 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& all_
   c.log = dir / "plots.log";
   c.job = "breakage/plots";
   ctx.runner.run(c);
+  publish_fastest_ledger_plot(ctx, rows, row_dirs);
   if (ctx.cfg.doc.str("breakage.conditions") == "transport")
     write_mill_product(ctx, jobs, write_in_mill_results(ctx, in_mill));
   ctx.progress.info(fmt::format(
-      "[breakage] results: {}/summary.csv, fractions.csv, size_distributions.csv, jk_fit.json, breakage.h5, plots/*.png",
+      "[breakage] results: {}/summary.csv, fractions.csv, size_distributions.csv, jk_fit.json, "
+      "comminution_efficiency.json, breakage.h5, plots/*.png",
       dir.string()));
 }
 

@@ -1,7 +1,7 @@
 // Stage 'breakage': one bonded-lump impact per (velocity, angle, repeat),
 // each followed by the fragment analysis; finalize merges the campaign into
-// breakage/summary.csv, fractions.csv, breakage.h5, plots and the critical
-// velocity.
+// breakage/summary.csv, fractions.csv, breakage.h5, plots, the critical
+// velocity and the comminution efficiency.
 #pragma once
 
 #include <map>
@@ -45,8 +45,9 @@ std::string damaged_impact_outputs(const std::filesystem::path& dir);
 std::string impact_line(const nlohmann::json& result);
 
 // One impact into `out_dir` (used by run_job and by `orchestrate impact`):
-// runs the deck, analyses the fragments, writes summary.csv, fractions.csv,
-// impact.h5, fragments.vtp and result.json there. Returns the summary line.
+// runs the deck, analyses the fragments and the energy ledger, writes
+// summary.csv, fractions.csv, impact.h5, energy_ledger.csv, energy_ledger.png,
+// fragments.vtp and result.json there. Returns the summary line.
 std::string run_impact(StageContext& ctx, double velocity, double angle, int repeat,
                        const std::filesystem::path& out_dir, const std::string& label);
 

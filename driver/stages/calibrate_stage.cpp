@@ -27,7 +27,7 @@ using namespace calibrate;
 
 // Bumped when a deck or the fitting scheme changes what a calibration gives.
 // 2 (Nov 2026): signed bond tension, moment factor and friction-angle levers.
-constexpr int kDeckVersion = 2;
+constexpr int kDeckVersion = 3;  // the energy ledger, midpoint bond increments
 
 const char* kCalibratedKeys[] = {"calibrated.bond_modulus",          "calibrated.stiffness_ratio",
                                  "calibrated.bond_tensile_strength", "calibrated.bond_cohesion",

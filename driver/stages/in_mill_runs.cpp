@@ -28,7 +28,7 @@ using post::kPi;
 constexpr double kG = 9.81;
 // 1: first version (issue 14).
 // 2: hub of 24 facets, skin of one mean element radius.
-constexpr int kInMillDeckVersion = 2;
+constexpr int kInMillDeckVersion = 3;  // the energy ledger, midpoint bond increments
 // Facets of the flywheel's hub circle in the in-mill runs (see run_in_mill).
 constexpr int kHubFacets = 24;
 // Neighbour skin in mean element radii: the turning flywheel forces a list
@@ -199,6 +199,7 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
               {"axis_x", num(g.axis_x)},
               {"axis_y", num(g.axis_height)},
               {"omega", num(omega)},
+              {"rim_speed", num(std::fabs(omega) * g.tip_radius())},
               {"g", num(kG)},
               {"x0", num(x0[0])},
               {"y0", num(x0[1])},
@@ -254,7 +255,7 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
   double element_mass = 0;
   for (const auto& e : a.snap.elements) element_mass += e.mass;
 
-  nlohmann::json j = lump_result_json(lr, a.result, res.seconds);
+  nlohmann::json j = lump_result_json(lr, a, res.seconds);
   const auto tally = [](const post::ContactTally& t) {
     return nlohmann::json{{"contacts", t.n},
                           {"elements", t.n_elements},

@@ -85,6 +85,23 @@ void write_fragments_vtp(const fs::path& file, const post::DumpSnapshot& snap,
   fs::rename(tmp, file);
 }
 
+// The run's energy ledger (ledger.csv, fix energy/ledger) and its summary,
+// whose figures also go into the impact's summary row.
+void read_energy_ledger(const LumpRun& run, LumpRunResult& a) {
+  const fs::path file = run.work / "ledger.csv";
+  if (!fs::exists(file))
+    throw std::runtime_error(fmt::format(
+        "{}: missing: the deck wrote no energy ledger (expected `fix energy/ledger ... file "
+        "ledger.csv`, docs/styles/fix_energy_ledger.md); log: {}",
+        file.string(), (run.work / "liggghts.log").string()));
+  a.ledger = post::ReadEnergyLedger(file.string());
+  a.energy = post::SummariseLedger(a.ledger);
+  post::ImpactSummary& s = a.result.summary;
+  s.comminution_efficiency = a.energy.comminution_efficiency;
+  s.ledger_residual_fraction = a.energy.residual_fraction;
+  s.max_element_speed_m_s = a.energy.max_speed_m_s;
+}
+
 long read_long(const fs::path& f) {
   std::ifstream in(f);
   double v = -1;
@@ -161,11 +178,29 @@ LumpRunResult analyse_lump_run(StageContext& ctx, const LumpRun& run,
   a.result =
       post::AnalyseImpact(a.snap.elements, bonds, is, (run.work / "bonds_final.txt").string());
   for (const auto& w : a.result.warnings) ctx.progress.warn(label + ": " + w);
+  read_energy_ledger(run, a);
   return a;
 }
 
-nlohmann::json lump_result_json(const LumpRun& run, const post::ImpactResult& r,
-                                double wall_seconds) {
+nlohmann::json energy_json(const post::LedgerSummary& e) {
+  nlohmann::json j = {{"end_time_s", e.end_time_s}};
+  for (const auto& [column, value] : e.final_energy) j[column] = value;
+  j["residual_fraction"] = e.residual_fraction;
+  j["residual_fraction_max"] = e.residual_fraction_max;
+  j["max_element_speed_m_s"] = e.max_speed_m_s;
+  j["max_element_speed_time_s"] = e.max_speed_time_s;
+  j["wall_overlap_max"] = e.wall_overlap_max;
+  j["comminution_efficiency"] = e.comminution_efficiency;
+  j["definitions"] = {
+      {"terms", "the ledger's last row (fix energy/ledger, docs/styles/fix_energy_ledger.md)"},
+      {"residual_fraction", "residual_J / (input_J + |work_other_J|), last row"},
+      {"comminution_efficiency",
+       "bond_released_J / (input_J + max(work_other_J, 0)) at the end of the run"}};
+  return j;
+}
+
+nlohmann::json lump_result_json(const LumpRun& run, const LumpRunResult& a, double wall_seconds) {
+  const post::ImpactResult& r = a.result;
   const auto& s = r.summary;
   return {{"velocity_m_s", s.velocity_m_s},
           {"angle_deg", s.angle_deg},
@@ -189,7 +224,8 @@ nlohmann::json lump_result_json(const LumpRun& run, const post::ImpactResult& r,
           {"t10_percent", s.t10_percent},
           {"t10_resolved", s.t10_resolved},
           {"warnings", r.warnings},
-          {"wall_seconds", wall_seconds}};
+          {"wall_seconds", wall_seconds},
+          {"energy", energy_json(a.energy)}};
 }
 
 void write_lump_outputs(const fs::path& out_dir, const LumpRunResult& a,
@@ -200,7 +236,11 @@ void write_lump_outputs(const fs::path& out_dir, const LumpRunResult& a,
   fs::remove(ftmp);
   post::AppendSummaryCsv(stmp.string(), a.result.summary);
   post::AppendFractionsCsv(ftmp.string(), a.result);
-  post::WriteBreakageH5((out_dir / "impact.h5").string(), {a.result});
+  const fs::path htmp = out_dir / "impact.h5.part";
+  post::WriteBreakageH5(htmp.string(), {a.result});
+  post::WriteEnergyLedgerH5(htmp.string(), a.ledger);
+  fs::rename(htmp, out_dir / "impact.h5");
+  post::WriteEnergyLedgerCsv((out_dir / "energy_ledger.csv").string(), a.ledger);
   write_fragments_vtp(out_dir / "fragments.vtp", a.snap, a.result);
   jobs::atomic_write(out_dir / "result.json", result.dump(2) + "\n");
   fs::rename(stmp, out_dir / "summary.csv");
@@ -211,10 +251,15 @@ std::string damaged_lump_outputs(const fs::path& dir) {
   if (auto r = jobs::first_problem(
           {jobs::check_file(dir / "summary.csv"), jobs::check_file(dir / "fractions.csv"),
            jobs::check_json(dir / "result.json"), jobs::check_hdf5(dir / "impact.h5"),
-           jobs::check_file(dir / "fragments.vtp")});
+           jobs::check_file(dir / "energy_ledger.csv"), jobs::check_file(dir / "fragments.vtp")});
       !r.empty())
     return r;
   try {
+    std::ifstream in(dir / "result.json");
+    if (!nlohmann::json::parse(in).contains("energy"))
+      return (dir / "result.json").string() +
+             ": no 'energy' object (written before the energy ledger)";
+    post::ReadEnergyLedger((dir / "energy_ledger.csv").string());
     const auto rows = post::ReadSummaryCsv((dir / "summary.csv").string());
     if (rows.size() != 1)
       return fmt::format("{}: {} rows, expected 1", (dir / "summary.csv").string(), rows.size());

@@ -2,8 +2,9 @@
 // on a plane (impact.in.tmpl) and the lump in the turning mill
 // (in_mill.in.tmpl): the lump with its calibrated bonds and random
 // orientation, the decks' -var settings for them, and the fragment analysis
-// of the final state with its outputs (summary.csv, fractions.csv, impact.h5,
-// fragments.vtp, result.json), each complete or absent.
+// of the final state and the run's energy ledger with its outputs
+// (summary.csv, fractions.csv, impact.h5, energy_ledger.csv, fragments.vtp,
+// result.json), each complete or absent.
 #pragma once
 
 #include <array>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "postprocess/breakage_results.h"
+#include "postprocess/energy_ledger.h"
 #include "postprocess/lammps_dump.h"
 #include "stages/lump_builder.h"
 #include "stages/material.h"
@@ -42,22 +44,30 @@ std::vector<std::pair<std::string, std::string>> lump_deck_vars(const StageConte
 
 struct LumpRunResult {
   post::DumpSnapshot snap;
-  post::ImpactResult result;
+  post::ImpactResult result;  // its summary holds the ledger's figures too
+  post::EnergyLedger ledger;
+  post::LedgerSummary energy;
 };
 
-// Reads the run's bonds_initial.txt, final.dump and bonds_final.txt (in
-// run.work) and analyses the fragments. Throws when elements were lost.
+// Reads the run's bonds_initial.txt, final.dump, bonds_final.txt and
+// ledger.csv (in run.work), analyses the fragments and summarises the ledger.
+// Throws when elements were lost or the deck wrote no ledger.
 LumpRunResult analyse_lump_run(StageContext& ctx, const LumpRun& run,
                                const post::ImpactConditions& conditions, double wall_seconds,
                                const std::string& label);
 
-// result.json of a run: the conditions, the lump, the bonds and the fragment
-// summary (callers add their own keys).
-nlohmann::json lump_result_json(const LumpRun& run, const post::ImpactResult& r,
-                                double wall_seconds);
+// result.json of a run: the conditions, the lump, the bonds, the fragment
+// summary and `energy` (energy_json; callers add their own keys).
+nlohmann::json lump_result_json(const LumpRun& run, const LumpRunResult& a, double wall_seconds);
 
-// Writes summary.csv, fractions.csv, impact.h5, fragments.vtp and
-// result.json into out_dir, each complete or absent.
+// result.json's `energy` object: the ledger's last row (one key per column in
+// J), input, residual fraction, fastest element, largest wall overlap and the
+// comminution efficiency (docs/breakage.md, "Energy ledger").
+nlohmann::json energy_json(const post::LedgerSummary& e);
+
+// Writes summary.csv, fractions.csv, impact.h5 (with /energy),
+// energy_ledger.csv, fragments.vtp and result.json into out_dir, each
+// complete or absent.
 void write_lump_outputs(const std::filesystem::path& out_dir, const LumpRunResult& a,
                         const nlohmann::json& result);
 

@@ -52,8 +52,13 @@ std::vector<fs::path> report_inputs(const fs::path& run) {
 
 // The stage's figures first in the order an engineer reads them, then the rest.
 int figure_rank(const fs::path& f) {
-  static const std::vector<std::string> first = {"jk_t10_vs_ecs.png", "passing_vs_size.png", "product_vs_rpm.png",
-                                                 "largest_vs_velocity.png", "pieces_vs_velocity.png"};
+  static const std::vector<std::string> first = {"jk_t10_vs_ecs.png",
+                                                 "passing_vs_size.png",
+                                                 "product_vs_rpm.png",
+                                                 "largest_vs_velocity.png",
+                                                 "pieces_vs_velocity.png",
+                                                 "comminution_efficiency_vs_velocity.png",
+                                                 "energy_ledger_fastest.png"};
   const auto it = std::find(first.begin(), first.end(), f.filename().string());
   return it == first.end() ? static_cast<int>(first.size()) : static_cast<int>(it - first.begin());
 }
@@ -123,7 +128,7 @@ Plan ReportStage::plan(const StageContext& ctx) const {
     in.push_back({fs::relative(f, ctx.run_dir).string(), static_cast<long long>(st.st_size),
                   static_cast<long long>(st.st_mtime)});
   }
-  p.jobs.push_back({"report", {{"inputs", in}, {"report_version", 3}},
+  p.jobs.push_back({"report", {{"inputs", in}, {"report_version", 4}},
                     "report/index.html and report/summary.json from every stage's outputs"});
   return p;
 }
@@ -281,15 +286,15 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
     if (!impacts.empty()) {
       raw << "<h3>Every impact</h3><table><tr><th>V [m/s]</th><th>angle [deg]</th><th>repeat</th><th>pieces</th>"
              "<th>single</th><th>multi</th><th>largest [%]</th><th>single mass [%]</th><th>broken bonds [%]</th>"
-             "<th>Ecs [kWh/t]</th><th>t10 [%]</th></tr>\n";
+             "<th>Ecs [kWh/t]</th><th>t10 [%]</th><th>comminution efficiency [%]</th></tr>\n";
       for (const auto& r : impacts)
         raw << fmt::format(
             "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>"
-            "<td>{}</td><td>{}</td><td>{}{}</td></tr>\n",
+            "<td>{}</td><td>{}</td><td>{}{}</td><td>{}</td></tr>\n",
             cell(r.velocity_m_s, "{:g}"), cell(r.angle_deg, "{:g}"), r.repeat, r.n_pieces, r.n_single, r.n_multi,
             cell(r.largest_mass_fraction, "{:.1f}", 100), cell(r.single_mass_fraction, "{:.1f}", 100),
             cell(r.broken_bond_fraction, "{:.1f}", 100), cell(r.specific_energy_kWh_t, "{:.3g}"),
-            cell(r.t10_percent, "{:.1f}"), r.t10_resolved ? "" : "*");
+            cell(r.t10_percent, "{:.1f}"), r.t10_resolved ? "" : "*", cell(r.comminution_efficiency, "{:.3g}", 100));
       raw << "</table><p class=note>* t10 not resolved: single elements are coarser than a tenth of the lump.</p>\n";
       summary["breakage_impacts"] = impacts.size();
     }

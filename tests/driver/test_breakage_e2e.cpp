@@ -37,7 +37,10 @@ TEST_F(TinyCampaign, RunsAndWritesEveryOutput) {
   for (const char* f : {"summary.csv", "fractions.csv", "breakage.h5", "critical_velocity.json",
                         "size_distributions.csv", "size_distributions.json", "jk_fit.json", "jk_points.csv",
                         "plots/largest_vs_velocity.png", "plots/pieces_vs_velocity.png", "plots/passing_vs_size.png",
-                        "plots/jk_t10_vs_ecs.png", "jobs/v20_a90_r0/fragments.vtp", "jobs/v20_a90_r0/result.json"})
+                        "plots/jk_t10_vs_ecs.png", "jobs/v20_a90_r0/fragments.vtp", "jobs/v20_a90_r0/result.json",
+                        "comminution_efficiency.json", "plots/comminution_efficiency_vs_velocity.png",
+                        "plots/energy_ledger_fastest.png", "jobs/v20_a90_r0/energy_ledger.csv",
+                        "jobs/v20_a90_r0/energy_ledger.png"})
     EXPECT_TRUE(fs::exists(*dir_ / "breakage" / f)) << f;
   EXPECT_FALSE(fs::exists(*dir_ / "breakage/plots/mass_distribution.png"));  // replaced by the passing curves
 }
@@ -82,6 +85,35 @@ TEST_F(TinyCampaign, SlowImpactBouncesIntactFastOneShatters) {
     EXPECT_LT(rows[i].largest_mass_fraction, rows[i - 1].largest_mass_fraction);
   }
   for (const auto& r : rows) EXPECT_EQ(r.n_elements, 200);
+}
+
+// The energy ledger of each impact in its result.json: the intact bounce
+// breaks nothing and makes no new surface; the shattering impact puts part of
+// the energy into broken bonds; every balance closes to within 1%.
+TEST_F(TinyCampaign, EnergyLedgerOfEveryImpact) {
+  ASSERT_EQ(status_, 0);
+  auto energy = [&](const char* job) {
+    return nlohmann::json::parse(slurp(*dir_ / "breakage/jobs" / job / "result.json")).at("energy");
+  };
+  const auto slow = energy("v1_a90_r0"), fast = energy("v150_a90_r0");
+  for (const auto& e : {slow, fast}) {
+    for (const char* k : {"input_J", "ke_trans_J", "bond_released_J", "contact_dissipated_J", "residual_fraction",
+                          "max_element_speed_m_s", "max_element_speed_time_s", "wall_overlap_max",
+                          "comminution_efficiency", "new_surface_m2", "energy_per_new_surface_J_m2"})
+      EXPECT_TRUE(e.contains(k)) << k;
+    EXPECT_LT(std::abs(e.at("residual_fraction").get<double>()), 0.01);
+    EXPECT_GT(e.at("input_J").get<double>(), 0.0);
+  }
+  EXPECT_EQ(slow.at("comminution_efficiency").get<double>(), 0.0);
+  EXPECT_EQ(slow.at("new_surface_m2").get<double>(), 0.0);
+  EXPECT_TRUE(slow.at("energy_per_new_surface_J_m2").is_null());
+  EXPECT_GT(fast.at("comminution_efficiency").get<double>(), 0.0);
+  EXPECT_LT(fast.at("comminution_efficiency").get<double>(), 1.0);
+  EXPECT_GT(fast.at("energy_per_new_surface_J_m2").get<double>(), 0.0);
+  const auto rows = mill::post::ReadSummaryCsv((*dir_ / "breakage" / "summary.csv").string());
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_DOUBLE_EQ(rows[2].comminution_efficiency, fast.at("comminution_efficiency").get<double>());
+  EXPECT_GE(rows[2].max_element_speed_m_s, 150.0 * 0.99);
 }
 
 TEST_F(TinyCampaign, SizeFractionsSumToOnePerImpact) {

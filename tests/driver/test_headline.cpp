@@ -91,6 +91,35 @@ TEST(Headline, ShaftPowerFromTheFlowReportWhenItHasIt) {
   fs::remove_all(run);
 }
 
+// The comminution efficiency from breakage/comminution_efficiency.json: at
+// the critical speed with its range over the sweep, or why there is none.
+TEST(Headline, ComminutionEfficiencyAtTheCriticalSpeed) {
+  namespace fs = std::filesystem;
+  const fs::path run = fs::temp_directory_path() / ("mill_headline_eff_" + std::to_string(getpid()));
+  fs::remove_all(run);
+  fs::create_directories(run / "breakage");
+  std::ofstream(run / "breakage/comminution_efficiency.json")
+      << R"([{"angle_deg": 90, "critical_velocity_m_s": 66.2, "impacts": 8, "at_critical_speed": 0.01234,
+              "mean": 0.011, "min": 0.0021, "max": 0.0305, "ledger_residual_fraction_max": 0.00042,
+              "definition": "..."},
+             {"angle_deg": 45, "critical_velocity_m_s": null, "impacts": 8, "at_critical_speed": null,
+              "mean": 0.004, "min": 0.001, "max": 0.008, "ledger_residual_fraction_max": 0.0001}])";
+  const json h = mill::report::headline_json(run);
+  EXPECT_NEAR(h.at("breakage").at("comminution_efficiency").at(0).at("at_critical_speed").get<double>(), 0.01234,
+              1e-15);
+  const auto rows = headline_rows(h);
+  EXPECT_EQ(value_of(rows, "comminution efficiency at the critical speed, 90 deg"),
+            "1.23% of the energy given went into broken bonds (0.21%-3.05% over the sweep)");
+  EXPECT_EQ(value_of(rows, "comminution efficiency at the critical speed, 45 deg"),
+            "critical speed not reached; 0.1%-0.8% over the sweep");
+  EXPECT_EQ(value_of(rows, "energy ledger residual, largest of the impacts, 90 deg"), "0.042% of the energy given");
+  for (const auto& r : rows) {
+    EXPECT_EQ(r.group, "Breakage of one lump (stage 2)") << r.what;
+    EXPECT_EQ(r.brief, r.what.rfind("comminution", 0) == 0) << r.what;
+  }
+  fs::remove_all(run);
+}
+
 TEST(Headline, NoJkFitSaysWhy) {
   const auto rows = headline_rows(json::parse(
       R"({"breakage": {"jk": [{"angle_deg": null, "fitted": false, "reason": "t10 not resolved at any impact"}]}})"));

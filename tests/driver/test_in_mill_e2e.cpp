@@ -126,6 +126,14 @@ TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAK
   EXPECT_EQ(missed.at("flywheel").at("contacts").get<long>(), 0) << missed.dump(2);
   EXPECT_EQ(missed.at("bonds_broken_at_strike").get<long>(), 0) << missed.dump(2);
   EXPECT_GT(missed.at("housing").at("contacts").get<long>(), 0) << missed.dump(2);
+  // The energy ledger of each run: the struck lump's broken bonds took part of
+  // the energy given (the rotor's work included); the balance closes.
+  EXPECT_GT(struck.at("energy").at("comminution_efficiency").get<double>(), 0.0) << struck.dump(2);
+  EXPECT_GT(struck.at("energy").at("work_other_J").get<double>(), 0.0) << struck.dump(2);
+  for (const auto& j : {struck, missed}) {
+    EXPECT_LT(std::abs(j.at("energy").at("residual_fraction").get<double>()), 0.01) << j.dump(2);
+    EXPECT_FALSE(j.at("energy").contains("energy_per_new_surface_J_m2"));  // impacts only
+  }
 
   // Element mass is conserved over the fragments.
   for (const char* l : {"rpm2000_mill_p1", "rpm2000_mill_p2"}) {

@@ -74,6 +74,47 @@ TEST(SummaryCsv, HeaderStartsWithTheRequiredColumnsInOrder) {
   const std::string header = FirstLine(dir / "summary.csv");
   EXPECT_EQ(header.substr(0, required.size()), required);
   EXPECT_EQ(header.substr(required.size(), 23), ",specific_energy_kWh_t,");
+  // The energy ledger's columns come last.
+  const std::string ledger = ",t10_resolved,comminution_efficiency,ledger_residual_fraction,max_element_speed_m_s";
+  ASSERT_GT(header.size(), ledger.size());
+  EXPECT_EQ(header.substr(header.size() - ledger.size()), ledger);
+  EXPECT_EQ(SummaryCsvColumns().size(), 24u);
+  EXPECT_EQ(SummaryCsvColumns().back(), "max_element_speed_m_s");
+}
+
+// The ledger's figures round-trip; without a ledger they are NaN ("nan"), and
+// a file from before the columns existed reads with NaN.
+TEST(SummaryCsv, LedgerColumnsRoundTripAndMayBeAbsent) {
+  const auto dir = TestDir();
+  const std::string path = (dir / "summary.csv").string();
+  ImpactSummary with = MakeImpact(60.0, 0).summary;
+  with.comminution_efficiency = 0.0123;
+  with.ledger_residual_fraction = -2.5e-4;
+  with.max_element_speed_m_s = 171.5;
+  AppendSummaryCsv(path, with);
+  AppendSummaryCsv(path, MakeImpact(90.0, 0).summary);
+  auto rows = ReadSummaryCsv(path);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_DOUBLE_EQ(rows[0].comminution_efficiency, 0.0123);
+  EXPECT_DOUBLE_EQ(rows[0].ledger_residual_fraction, -2.5e-4);
+  EXPECT_DOUBLE_EQ(rows[0].max_element_speed_m_s, 171.5);
+  EXPECT_TRUE(std::isnan(rows[1].comminution_efficiency));
+
+  const std::string old = (dir / "old.csv").string();
+  std::ifstream in(path);
+  std::string header, row;
+  std::getline(in, header);
+  std::getline(in, row);
+  const std::string tail = ",comminution_efficiency,ledger_residual_fraction,max_element_speed_m_s";
+  ASSERT_EQ(header.substr(header.size() - tail.size()), tail);
+  std::string short_row = row;  // without its last three values
+  for (int k = 0; k < 3; ++k) short_row.erase(short_row.rfind(','));
+  std::ofstream(old) << header.substr(0, header.size() - tail.size()) << "\n" << short_row << "\n";
+  rows = ReadSummaryCsv(old);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_DOUBLE_EQ(rows[0].velocity_m_s, 60.0);
+  EXPECT_TRUE(std::isnan(rows[0].comminution_efficiency));
+  EXPECT_TRUE(std::isnan(rows[0].max_element_speed_m_s));
 }
 
 TEST(SummaryCsv, AppendsRowsUnderOneHeaderAndReadsBack) {
@@ -184,6 +225,16 @@ TEST(Impact, T10FlagWhenElementsAreCoarserThanTenthOfD) {
   EXPECT_NEAR(r.summary.element_d_rel_max, std::cbrt(0.1), 1e-12);
   ASSERT_EQ(r.warnings.size(), 1u);
   EXPECT_NE(r.warnings[0].find("t10"), std::string::npos);
+}
+
+// Ten elements of d = 2.4 mm: a chain of 4 and 6 singles out of one lump of
+// 10 element volumes; new surface = pi d^2 (6 + 4^(2/3) - 10^(2/3)).
+TEST(Impact, NewSurfaceOfThePieces) {
+  const double d = 2.4e-3;
+  const auto r = MakeImpact(60.0, 0);
+  EXPECT_NEAR(r.new_surface_m2,
+              kPi * d * d * (6.0 + std::pow(4.0, 2.0 / 3.0) - std::pow(10.0, 2.0 / 3.0)), 1e-15);
+  EXPECT_EQ(MakeImpact(60.0, 0, 10, 10).new_surface_m2, 0.0);  // intact
 }
 
 TEST(Impact, GroupName) {
@@ -313,6 +364,100 @@ TEST(BreakageH5, JkFitGroupWithUnits) {
   const hid_t g = H5Gopen2(file, "/jk_fit/a90", H5P_DEFAULT);
   EXPECT_EQ(ReadStringAttr(g, "status"), "fitted");
   H5Gclose(g);
+  H5Fclose(file);
+}
+
+// Reads a 1-D double dataset.
+std::vector<double> ReadDoubles(hid_t file, const std::string& name) {
+  const hid_t set = H5Dopen2(file, name.c_str(), H5P_DEFAULT);
+  if (set < 0) return {};
+  const hid_t space = H5Dget_space(set);
+  std::vector<double> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)));
+  H5Dread(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
+  H5Sclose(space);
+  H5Dclose(set);
+  return v;
+}
+
+// The unit attribute of a dataset.
+std::string UnitOf(hid_t file, const std::string& name) {
+  const hid_t set = H5Dopen2(file, name.c_str(), H5P_DEFAULT);
+  if (set < 0) return "(no dataset)";
+  const std::string unit = ReadStringAttr(set, "unit");
+  H5Dclose(set);
+  return unit;
+}
+
+// impact.h5 /energy: one dataset per ledger column with its unit; the merge
+// copies it into the impact's own group of breakage.h5.
+TEST(BreakageH5, EnergyGroupWithUnitsAndItsMerge) {
+  const auto dir = TestDir();
+  const std::string a = (dir / "a.h5").string(), b = (dir / "b.h5").string();
+  const EnergyLedger ledger = ReadEnergyLedger(std::string(MILL_POST_TEST_DATA) + "/ledger_small.csv");
+  WriteBreakageH5(a, {MakeImpact(150.0, 0)});
+  WriteEnergyLedgerH5(a, ledger);
+  WriteEnergyLedgerH5(a, ledger);  // replaced, not duplicated
+  WriteBreakageH5(b, {MakeImpact(20.0, 0)});
+
+  hid_t file = H5Fopen(a.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  EXPECT_EQ(ReadDoubles(file, "/energy/bond_released_J"), (std::vector<double>{0, 2, 3}));
+  EXPECT_EQ(UnitOf(file, "/energy/bond_released_J"), "J");
+  EXPECT_EQ(UnitOf(file, "/energy/time_s"), "s");
+  EXPECT_EQ(UnitOf(file, "/energy/max_speed_m_s"), "m/s");
+  EXPECT_EQ(UnitOf(file, "/energy/wall_overlap"), "1");
+  EXPECT_EQ(UnitOf(file, "/energy/step"), "1");
+  const hid_t g = H5Gopen2(file, "/energy", H5P_DEFAULT);
+  EXPECT_NE(ReadStringAttr(g, "balance").find("input + work_other = ke_trans"), std::string::npos);
+  H5Gclose(g);
+  H5Fclose(file);
+
+  const std::string merged = (dir / "breakage.h5").string();
+  MergeBreakageH5Files(merged, {a, b});
+  file = H5Fopen(merged.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  EXPECT_EQ(ReadDoubles(file, "/impacts/v150.0_a90_r0/energy/time_s"),
+            (std::vector<double>{0, 1e-5, 2e-5}));
+  EXPECT_EQ(UnitOf(file, "/impacts/v150.0_a90_r0/energy/input_J"), "J");
+  EXPECT_EQ(H5Lexists(file, "/impacts/v20.0_a90_r0/energy", H5P_DEFAULT), 0);  // b has no ledger
+  EXPECT_EQ(H5Lexists(file, "/energy", H5P_DEFAULT), 0);
+  H5Fclose(file);
+
+  // A file of two impacts with an /energy: whose ledger is it?
+  const std::string two = (dir / "two.h5").string();
+  WriteBreakageH5(two, {MakeImpact(60.0, 0), MakeImpact(90.0, 0)});
+  WriteEnergyLedgerH5(two, ledger);
+  try {
+    MergeBreakageH5Files((dir / "bad.h5").string(), {two});
+    FAIL() << "expected PostError";
+  } catch (const PostError& e) {
+    EXPECT_NE(std::string(e.what()).find("two.h5: /energy beside 2 impacts"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir / "bad.h5"));
+}
+
+// An impact.h5 from before the ledger's summary columns merges; they read NaN.
+TEST(BreakageH5, MergeOfAFileWithoutTheLedgerColumns) {
+  const auto dir = TestDir();
+  const std::string a = (dir / "a.h5").string();
+  ImpactResult r = MakeImpact(150.0, 0);
+  r.summary.comminution_efficiency = 0.5;
+  WriteBreakageH5(a, {r});
+  hid_t file = H5Fopen(a.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  const hid_t g = H5Gopen2(file, "/impacts/v150.0_a90_r0", H5P_DEFAULT);
+  for (const char* name :
+       {"comminution_efficiency", "ledger_residual_fraction", "max_element_speed_m_s"})
+    ASSERT_GE(H5Adelete(g, name), 0) << name;
+  H5Gclose(g);
+  H5Fclose(file);
+  const std::string merged = (dir / "breakage.h5").string();
+  MergeBreakageH5Files(merged, {a});
+  file = H5Fopen(merged.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  const auto eff = ReadDoubles(file, "/summary/comminution_efficiency");
+  ASSERT_EQ(eff.size(), 1u);
+  EXPECT_TRUE(std::isnan(eff[0]));
+  EXPECT_EQ(UnitOf(file, "/summary/max_element_speed_m_s"), "m/s");
   H5Fclose(file);
 }
 

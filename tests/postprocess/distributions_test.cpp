@@ -91,6 +91,20 @@ TEST(CriticalVelocity, SpreadOverRepeats) {
   EXPECT_NEAR(*c.stddev, (28.0 - (20.0 + 2.0 / 0.28)) / std::sqrt(2.0), 1e-12);
 }
 
+// The repeat-averaged curve (10: 1.0, 20: 0.4, 30: 0.01) read between and at
+// its speeds, and nowhere outside them.
+TEST(CriticalVelocity, MeanCurveAtASpeed) {
+  const std::vector<SweepPoint> pts = {{10, 0, 1.0}, {20, 0, 0.5}, {30, 0, 0.0},
+                                       {10, 1, 1.0}, {20, 1, 0.3}, {30, 1, 0.02}};
+  EXPECT_DOUBLE_EQ(*MeanCurveAt(pts, 20.0), 0.4);
+  EXPECT_DOUBLE_EQ(*MeanCurveAt(pts, 10.0), 1.0);
+  EXPECT_DOUBLE_EQ(*MeanCurveAt(pts, 30.0), 0.01);
+  EXPECT_NEAR(*MeanCurveAt(pts, 25.0), 0.205, 1e-15);
+  EXPECT_FALSE(MeanCurveAt(pts, 9.9).has_value());
+  EXPECT_FALSE(MeanCurveAt(pts, 30.1).has_value());
+  EXPECT_FALSE(MeanCurveAt({}, 20.0).has_value());
+}
+
 }  // namespace
 }  // namespace mill::post
 

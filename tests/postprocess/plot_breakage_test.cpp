@@ -52,6 +52,7 @@ TEST(PlotBreakage, WritesPngsAndCriticalVelocity) {
       s.n_pieces = s.n_single + s.n_multi;
       s.largest_mass_fraction = largest[rep][k];
       s.specific_energy_J_kg = 0.5 * speeds[k] * speeds[k];
+      s.comminution_efficiency = 0.01 * (k + 1) + 0.002 * rep;
       AppendSummaryCsv(summary, s);
       points.push_back({speeds[k], rep, largest[rep][k]});
     }
@@ -65,8 +66,8 @@ TEST(PlotBreakage, WritesPngsAndCriticalVelocity) {
                           passing + " --out " + out.string() +
                           " --threshold 0.05 --velocities 20,100,150";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-  for (const char* png :
-       {"pieces_vs_velocity.png", "largest_vs_velocity.png", "passing_vs_size.png"}) {
+  for (const char* png : {"pieces_vs_velocity.png", "largest_vs_velocity.png", "passing_vs_size.png",
+                          "comminution_efficiency_vs_velocity.png"}) {
     ASSERT_TRUE(fs::exists(out / png)) << png;
     EXPECT_GT(fs::file_size(out / png), 1000u) << png;
   }
@@ -106,6 +107,50 @@ TEST(PlotJk, DrawsPointsFitAndOreCardAndNamesABadFile) {
   std::ifstream err(dir / "err.txt");
   const std::string text((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("A_percent"), std::string::npos) << text;
+}
+
+// A summary.csv without ledgers (efficiency NaN) draws no efficiency plot.
+TEST(PlotBreakage, NoEfficiencyPlotWithoutLedgers) {
+  if (!PythonHasPlotting()) GTEST_SKIP() << kPython << " lacks matplotlib/numpy";
+  const fs::path dir = fs::temp_directory_path() / "mill_post_plot_no_ledger";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "plots");
+  std::ofstream(dir / "plots" / "comminution_efficiency_vs_velocity.png") << "stale";
+  const std::string summary = (dir / "summary.csv").string();
+  for (double v : {20.0, 60.0}) {
+    ImpactSummary s;
+    s.velocity_m_s = v;
+    s.n_single = 3;
+    s.largest_mass_fraction = 60.0 / v / 3.0;
+    AppendSummaryCsv(summary, s);
+  }
+  const std::string cmd =
+      kPython + " " + kScript + " --summary " + summary + " --out " + (dir / "plots").string();
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  EXPECT_TRUE(fs::exists(dir / "plots" / "largest_vs_velocity.png"));
+  EXPECT_FALSE(fs::exists(dir / "plots" / "comminution_efficiency_vs_velocity.png"));
+}
+
+// plot_energy_ledger.py on the hand-written ledger: a PNG; a ledger without
+// a column stops with the file, line and column.
+TEST(PlotEnergyLedger, DrawsTheStackAndNamesAMissingColumn) {
+  if (!PythonHasPlotting()) GTEST_SKIP() << kPython << " lacks matplotlib/numpy";
+  const fs::path dir = fs::temp_directory_path() / "mill_post_plot_ledger";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string base = kPython + " " + MILL_PLOT_ENERGY_LEDGER_SCRIPT + " --ledger ";
+  const std::string good = base + MILL_POST_TEST_DATA + "/ledger_small.csv --out " +
+                           (dir / "energy_ledger.png").string() + " --title '150 m/s at 90 deg'";
+  ASSERT_EQ(std::system(good.c_str()), 0) << good;
+  EXPECT_GT(fs::file_size(dir / "energy_ledger.png"), 1000u);
+  EXPECT_FALSE(fs::exists(dir / "energy_ledger.png.tmp"));
+  std::ofstream(dir / "bad.csv") << "# a comment\nstep,time_s,input_J\n0,0,1\n";
+  const std::string bad = base + (dir / "bad.csv").string() + " --out " +
+                          (dir / "bad.png").string() + " 2> " + (dir / "err.txt").string();
+  EXPECT_NE(std::system(bad.c_str()), 0);
+  std::ifstream err(dir / "err.txt");
+  const std::string text((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("bad.csv:2: missing column(s) work_other_J"), std::string::npos) << text;
 }
 
 TEST(PlotBreakage, MissingColumnFailsWithItsName) {
