@@ -127,7 +127,7 @@ struct FixBondBreakable::BondResult {
   double energy;    // elastic energy stored in the bond [J]
   double stretch;   // L - L0 [m] (< 0: compressed)
   double released;  // what a bond that breaks now takes with it [J] (advance only)
-  double damped;    // taken this step by the dashpots [J] (advance only)
+  Vec3 fdash;       // the dashpots' part of the force on b [N]
   double slipped;   // taken this step by Coulomb slip of a contact [J] (advance only)
   Vec3 centre;      // bond centre (contact point)
   int mode;         // 0 intact, 1 tension, 2 shear
@@ -336,6 +336,7 @@ void FixBondBreakable::setup(int /*vflag*/) {
   compute_bonds(false);
   if (!ledger_started_) {
     ledger_.work.start(bond_power(), update->dt);
+    ledger_.damping.start(dashpot_power(), update->dt);
     ledger_.elastic0 = ledger_.elastic;
     ledger_started_ = true;
     ledger_step_ = update->ntimestep;
@@ -354,8 +355,34 @@ void FixBondBreakable::pre_exchange() { store_history(); }
 // (trapezoidal rule, energy_terms.h); the periodic bond dump.
 void FixBondBreakable::end_of_step() {
   ledger_.work.add(bond_power(), update->dt);
+  if (damping_ > 0.0) ledger_.damping.add(dashpot_power(), update->dt);
   ledger_step_ = update->ntimestep;
   if (dump_every_ > 0 && update->ntimestep % dump_every_ == 0) write_bond_dump();
+}
+
+double FixBondBreakable::local_damping_now() const {
+  if (ledger_step_ == update->ntimestep || damping_ <= 0.0) return ledger_.damping.value();
+  return ledger_.damping.value_with(dashpot_power(), update->dt);
+}
+
+// Power the dashpots take: -f_d . (relative velocity of the contact point) at
+// the full-step velocities, each bond once [W].
+double FixBondBreakable::dashpot_power() const {
+  if (damping_ <= 0.0) return 0.0;
+  double **x = atom->x, **v = atom->v, **omega = atom->omega;
+  const double *radius = atom->radius;
+  const size_t n = std::min(list_.size(), dash_.size() / 3);
+  double p = 0.0;
+  for (size_t e = 0; e < n; ++e) {
+    const Vec3 fd = load3(&dash_[3 * e]);
+    if (fd.x == 0.0 && fd.y == 0.0 && fd.z == 0.0) continue;
+    const ListedBond &lb = list_[e];
+    const Vec3 d = load3(x[lb.b]) - load3(x[lb.a]);
+    const PairMotion m = pair_motion(d, std::sqrt(dot(d, d)), load3(v[lb.a]), load3(v[lb.b]),
+                                     load3(omega[lb.a]), load3(omega[lb.b]), radius[lb.a], radius[lb.b]);
+    p -= dot(fd, m.vn * m.n + m.vt);
+  }
+  return p;
 }
 
 double FixBondBreakable::local_work_now() const {
@@ -662,7 +689,8 @@ inline void FixBondBreakable::evaluate_bond(const AtomArrays &at, ListedBond &bo
                0.5 * inv_kn *
                    (stiffness_ratio_ * fs_sq * bond.inv_area + mb_sq * bond.inv_inertia +
                     stiffness_ratio_ * mt * mt * 0.5 * bond.inv_inertia);
-  out.damped = out.slipped = 0.0;
+  out.slipped = 0.0;
+  out.fdash = {0.0, 0.0, 0.0};
   out.mode = 0;
   if (out.sigma > tensile_strength_)
     out.mode = 1;
@@ -675,7 +703,7 @@ inline void FixBondBreakable::evaluate_bond(const AtomArrays &at, ListedBond &bo
   Vec3 fb = -fn * n + fs;
   if (damping_ > 0.0) {
     fb = fb - (bond.cn * m.vn * n + bond.cs * m.vt);
-    if (advance) out.damped = (bond.cn * m.vn * m.vn + bond.cs * dot(m.vt, m.vt)) * dt;
+    out.fdash = -(bond.cn * m.vn * n + bond.cs * m.vt);
   }
   out.fa = -fb;
 
@@ -716,7 +744,8 @@ inline bool FixBondBreakable::evaluate_contact(const AtomArrays &at, ListedBond 
   const double stretch = len - bond.l0;
   out.mode = 0;
   out.energy = 0.0;
-  out.damped = out.slipped = 0.0;
+  out.slipped = 0.0;
+  out.fdash = {0.0, 0.0, 0.0};
   out.stretch = stretch;
   if (len > bond.drop_len) return false;
   if (stretch >= 0.0) {  // open: no force, no stored shear or moment (contact lost)
@@ -760,7 +789,7 @@ inline bool FixBondBreakable::evaluate_contact(const AtomArrays &at, ListedBond 
   if (damping_ > 0.0) {
     const double fd = std::min(bond.cn * m.vn, push);  // the dashpot's share, never a pull
     push -= fd;
-    if (advance) out.damped += fd * m.vn * at.dt;
+    out.fdash = -fd * n;
   }
   const Vec3 fb = push * n + fs;
   out.fa = -fb;
@@ -926,6 +955,7 @@ void FixBondBreakable::compute_bonds(bool advance) {
   double local[4] = {0.0, 0.0, 0.0, 0.0};  // intact, new tension, new shear, energy
   double stored = 0.0;                      // ledger: bonds and pressed contacts [J]
   BondResult r;
+  if (damping_ > 0.0) dash_.assign(3 * list_.size(), 0.0);
   // The ledger's snapshot: forces and torques before the bonds add theirs.
   fbond_.resize(6 * static_cast<size_t>(nlocal));
   for (int i = 0; i < nlocal; ++i) {
@@ -971,7 +1001,7 @@ void FixBondBreakable::compute_bonds(bool advance) {
         if (lb.i_lower) {
           stored += r.energy;
           ledger_.friction += r.slipped;
-          ledger_.damping += r.damped;
+          if (damping_ > 0.0) store3(&dash_[3 * e], r.fdash);
         }
       } else if (advance) {
         remove_later(lb);
@@ -1010,7 +1040,7 @@ void FixBondBreakable::compute_bonds(bool advance) {
     if (lb.i_lower) {
       local[0] += 1.0;
       local[3] += r.energy;
-      ledger_.damping += r.damped;
+      if (damping_ > 0.0) store3(&dash_[3 * e], r.fdash);
     }
   }
   if (advance) history_dirty_ = true;

@@ -69,13 +69,15 @@ class FixBondBreakable : public Fix {
     double elastic = 0.0;       // stored now: intact bonds and pressed contacts
     double elastic0 = 0.0;      // stored at the start of the first run
     double released = 0.0;      // stored in bonds at the step they broke, cumulative
-    double damping = 0.0;       // taken by the dashpots, cumulative
+    mill::PowerIntegral damping;  // taken by the dashpots (power at the full steps)
     double friction = 0.0;      // taken by Coulomb slip of contacts, cumulative
   };
   const Energy &local_energy() const { return ledger_; }
   // This rank's work of the bonds up to the current step, whether or not
   // this fix's end_of_step ran yet [J].
   double local_work_now() const;
+  // This rank's dashpot losses up to the current step, likewise [J].
+  double local_damping_now() const;
   // sum of end_term() over this step's bond forces (energy_terms.h) [1/s^2 J].
   double local_end_term() const;
 
@@ -163,6 +165,11 @@ class FixBondBreakable : public Fix {
   bool ledger_started_ = false;
   bigint ledger_step_ = -1;  // the step whose power the work holds
   double bond_power() const;  // sum of F.v + T.omega of fbond_ [W]
+  // With damping: each listed bond's dashpot force on b this step (3 per
+  // entry, zero for bonds counted elsewhere), and the power they take at the
+  // full-step velocities [W].
+  std::vector<double> dash_;
+  double dashpot_power() const;
 
   std::vector<int> broken_;   // slots to remove this step: i, j, tag i, partner tag
   std::vector<int> contact_;  // bonds that became contacts this step: list entries

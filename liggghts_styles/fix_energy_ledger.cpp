@@ -296,7 +296,7 @@ void FixEnergyLedger::sample(bool write) {
     loc[BE] = b.elastic;
     loc[BE0] = b.elastic0;
     loc[BR] = b.released;
-    loc[BD] = b.damping;
+    loc[BD] = bonds_->local_damping_now();
     loc[BF] = b.friction;
   }
   if (wall_) {
