@@ -390,11 +390,12 @@ double FixBondBreakable::local_work_now() const {
   return ledger_.work.value_with(bond_power(), update->dt);
 }
 
-double FixBondBreakable::local_end_term() const {
+double FixBondBreakable::local_end_term(int groupbit) const {
   const int n = std::min(atom->nlocal, static_cast<int>(fbond_.size() / 6));
   double s = 0.0;
   for (int i = 0; i < n; ++i)
-    s += mill::end_term(&fbond_[6 * i], &fbond_[6 * i + 3], atom->f[i], atom->torque[i], atom->rmass[i],
+    if (atom->mask[i] & groupbit)
+      s += mill::end_term(&fbond_[6 * i], &fbond_[6 * i + 3], atom->f[i], atom->torque[i], atom->rmass[i],
                         atom->radius[i]);
   return s;
 }

@@ -78,8 +78,9 @@ class FixBondBreakable : public Fix {
   double local_work_now() const;
   // This rank's dashpot losses up to the current step, likewise [J].
   double local_damping_now() const;
-  // sum of end_term() over this step's bond forces (energy_terms.h) [1/s^2 J].
-  double local_end_term() const;
+  // sum of end_term() over this step's bond forces on the atoms of groupbit,
+  // the ones velocity Verlet integrates (energy_terms.h).
+  double local_end_term(int groupbit) const;
 
  private:
   // Parameters (SI units, see the doc page).

@@ -15,6 +15,7 @@
 #include "fix_bond_breakable.h"
 #include "fix_wall_halfspace.h"
 #include "force.h"
+#include "group.h"
 #include "lmptype.h"
 #include "modify.h"
 #include "neigh_list.h"
@@ -79,6 +80,8 @@ void FixEnergyLedger::parse_args(int narg, char **arg) {
       poisson_ = args.real("poisson", val);
       if (!(poisson_ > -1.0 && poisson_ < 0.5)) fail(std::string("poisson must be in (-1, 0.5), got ") + val);
       have_nu = true;
+    } else if (key == "integrated") {
+      integrated_ = val;
     } else if (key == "bonds") {
       bond_id_ = val;
     } else if (key == "wall") {
@@ -94,8 +97,8 @@ void FixEnergyLedger::parse_args(int narg, char **arg) {
       if (!(residual_floor_ >= 0.0)) fail(std::string("residual_floor must be >= 0 J, got ") + val);
     } else {
       fail("unknown keyword '" + key +
-           "' (expected every, interval, file, youngs, poisson, bonds, wall, speed_bound, residual_bound, "
-           "residual_floor)");
+           "' (expected every, interval, file, youngs, poisson, integrated, bonds, wall, speed_bound, "
+           "residual_bound, residual_floor)");
     }
     iarg += 2;
   }
@@ -111,6 +114,13 @@ void FixEnergyLedger::init() {
     error->all(FLERR, "fix energy/ledger: needs atom_style sphere (radius, rmass, omega, torque)");
   bonds_ = nullptr;
   wall_ = nullptr;
+  // The integrated group may be made after this fix (a lab deck separates the
+  // platens after the bonds are made): until it exists, the fix's group.
+  moved_ = groupbit;
+  if (!integrated_.empty()) {
+    const int ig = group->find(integrated_.c_str());
+    if (ig >= 0) moved_ = group->bitmask[ig];
+  }
   if (!bond_id_.empty()) {
     bonds_ = dynamic_cast<FixBondBreakable *>(modify->find_fix_id(bond_id_.c_str()));
     if (!bonds_) error->all(FLERR, ("fix energy/ledger: bonds " + bond_id_ + ": no fix bond/breakable with that ID").c_str());
@@ -199,7 +209,7 @@ void FixEnergyLedger::local_kinetic(double &trans, double &rot, double &shadow) 
   const double dt2 = update->dt * update->dt;
   trans = rot = shadow = 0.0;
   for (int i = 0; i < atom->nlocal; ++i) {
-    if (!(mask[i] & groupbit)) continue;
+    if (!(mask[i] & moved_)) continue;
     const double m = rmass[i], inertia = 0.4 * m * radius[i] * radius[i];
     trans += 0.5 * m * (v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2]);
     rot += 0.5 * inertia * (omega[i][0] * omega[i][0] + omega[i][1] * omega[i][1] + omega[i][2] * omega[i][2]);
@@ -247,7 +257,7 @@ void FixEnergyLedger::end_of_step() {
   const int *mask = atom->mask;
   const double bound_sq = speed_bound_ * speed_bound_;
   for (int i = 0; i < atom->nlocal; ++i) {
-    if (!(mask[i] & groupbit)) continue;
+    if (!(mask[i] & moved_)) continue;
     const double s2 = v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2];
     vmax_sq_ = std::max(vmax_sq_, s2);
     if (speed_bound_ > 0.0 && s2 > bound_sq) {
@@ -282,17 +292,19 @@ void FixEnergyLedger::sample(bool write) {
   local_kinetic(loc[T], loc[R], loc[S]);
   loc[CE] = local_contact_elastic();
   // Exact velocity-Verlet work of each family: the trapezoid less its end
-  // term dt^2/4 sum f.F/m (+ torques), energy_terms.h.
+  // term dt^2/4 sum f.F/m (+ torques), energy_terms.h, over the group's atoms
+  // (atoms moved at a set speed, such as platens, need no end term).
   const double q = 0.25 * update->dt * update->dt;
   double pair_end = 0.0;
   const int np = std::min(atom->nlocal, static_cast<int>(fpair_.size() / 6));
   for (int i = 0; i < np; ++i)
-    pair_end += mill::end_term(&fpair_[6 * i], &fpair_[6 * i + 3], atom->f[i], atom->torque[i], atom->rmass[i],
+    if (atom->mask[i] & moved_)
+      pair_end += mill::end_term(&fpair_[6 * i], &fpair_[6 * i + 3], atom->f[i], atom->torque[i], atom->rmass[i],
                                atom->radius[i]);
   loc[WP] = pair_work_.value() - q * pair_end;
   if (bonds_) {
     const auto &b = bonds_->local_energy();
-    loc[WB] = bonds_->local_work_now() - q * bonds_->local_end_term();
+    loc[WB] = bonds_->local_work_now() - q * bonds_->local_end_term(moved_);
     loc[BE] = b.elastic;
     loc[BE0] = b.elastic0;
     loc[BR] = b.released;
@@ -302,7 +314,7 @@ void FixEnergyLedger::sample(bool write) {
   if (wall_) {
     const auto &w = wall_->local_energy();
     wall_->local_work_now(loc[WW], loc[WD]);
-    loc[WW] -= q * wall_->local_end_term();
+    loc[WW] -= q * wall_->local_end_term(moved_);
     loc[WE] = w.elastic;
     loc[WE0] = w.elastic0;
     loc[WF] = w.friction;

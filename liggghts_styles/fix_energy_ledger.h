@@ -68,6 +68,8 @@ class FixEnergyLedger : public Fix {
   double interval_ = 0.0;            // time between samples [s]; sets every_ at init
   std::string file_;                 // the ledger file (CSV), rank 0
   std::string bond_id_, wall_id_;    // fixes whose terms are read
+  std::string integrated_;           // group velocity Verlet moves (default: the fix's)
+  int moved_ = 0;                    // its bit, found at each init
   double youngs_ = 0.0, poisson_ = 0.0;  // element E [Pa], nu (Hertz energy of contacts)
   double speed_bound_ = 0.0;         // fastest element allowed [m/s]; 0 = no check
   double residual_bound_ = 0.0;      // |residual| / (input + |other work|) allowed; 0 = none

@@ -268,10 +268,11 @@ void FixWallHalfspace::step_power(double &p, double &pd) const {
   }
 }
 
-double FixWallHalfspace::local_end_term() const {
+double FixWallHalfspace::local_end_term(int groupbit) const {
   double s = 0.0;
   for (const Touch &t : touches_)
-    s += mill::end_term(t.f, t.t, atom->f[t.i], atom->torque[t.i], atom->rmass[t.i], atom->radius[t.i]);
+    if (atom->mask[t.i] & groupbit)
+      s += mill::end_term(t.f, t.t, atom->f[t.i], atom->torque[t.i], atom->rmass[t.i], atom->radius[t.i]);
   return s;
 }
 

@@ -58,8 +58,9 @@ class FixWallHalfspace : public Fix {
   // This rank's work on the elements and dashpot losses up to the current
   // step, whether or not this fix's end_of_step ran yet [J].
   void local_work_now(double &work, double &damping) const;
-  // sum of end_term() over this step's wall forces (energy_terms.h).
-  double local_end_term() const;
+  // sum of end_term() over this step's wall forces on the atoms of groupbit,
+  // the ones velocity Verlet integrates (energy_terms.h).
+  double local_end_term(int groupbit) const;
 
   // Contact law of one element on the wall (LIGGGHTS's hertz model; public
   // for the analytic tests). Effective Young's and shear moduli [Pa] and the
