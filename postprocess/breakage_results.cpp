@@ -128,16 +128,20 @@ void AppendCsvRows(const std::string& path, const std::string& header,
     }
     if (!existing.empty() && existing.back() != '\n') existing += '\n';
   }
+  std::string text = existing.empty() ? header + '\n' : existing;
+  for (const std::string& r : rows) text += r + '\n';
+  WriteTextAtomically(path, text);
+}
+
+}  // namespace
+
+// Writes text to path.tmp and renames it over path: the file is whole or absent.
+void WriteTextAtomically(const std::string& path, const std::string& text) {
   const std::string tmp = path + ".tmp";
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw PostError(fmt::format("{}: cannot write", tmp));
-    if (existing.empty()) {
-      out << header << '\n';
-    } else {
-      out << existing;
-    }
-    for (const std::string& r : rows) out << r << '\n';
+    out << text;
     out.flush();
     if (!out) {
       out.close();
@@ -148,6 +152,8 @@ void AppendCsvRows(const std::string& path, const std::string& header,
   }
   fs::rename(tmp, path);
 }
+
+namespace {
 
 // Owns an HDF5 id and closes it with the matching H5*close.
 class H5Id {

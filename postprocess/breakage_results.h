@@ -15,6 +15,10 @@
 
 namespace mill::post {
 
+// Writes text to path.tmp, then renames it over path: whole or absent.
+// Throws PostError naming the file when it cannot be written.
+void WriteTextAtomically(const std::string& path, const std::string& text);
+
 // Which impact of a sweep this is.
 struct ImpactConditions {
   double velocity_m_s = 0.0;  // impact speed V

@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "postprocess/breakage_results.h"
 #include "postprocess/fragments.h"
 
 namespace mill::post {
@@ -202,25 +203,14 @@ EnergyLedger ReadEnergyLedger(const std::string& path) {
 
 // The ledger back into its CSV format.
 void WriteEnergyLedgerCsv(const std::string& path, const EnergyLedger& l) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw PostError(fmt::format("{}: cannot write", tmp));
-    out << kComment << '\n' << JoinFields(l.columns) << '\n';
-    for (std::size_t k = 0; k < l.rows(); ++k) {
-      for (std::size_t c = 0; c < l.columns.size(); ++c)
-        out << (c ? "," : "") << fmt::format("{}", l.values[c][k]);
-      out << '\n';
-    }
-    out.flush();
-    if (!out) {
-      out.close();
-      std::error_code ignored;
-      fs::remove(tmp, ignored);
-      throw PostError(fmt::format("{}: write failed (disk full?)", tmp));
-    }
+  std::ostringstream out;
+  out << kComment << '\n' << JoinFields(l.columns) << '\n';
+  for (std::size_t k = 0; k < l.rows(); ++k) {
+    for (std::size_t c = 0; c < l.columns.size(); ++c)
+      out << (c ? "," : "") << fmt::format("{}", l.values[c][k]);
+    out << '\n';
   }
-  fs::rename(tmp, path);
+  WriteTextAtomically(path, out.str());
 }
 
 // The last row's terms, the extremes and the efficiency.
