@@ -107,6 +107,23 @@ struct PairMotion {
   return m;
 }
 
+// The same pair without the relative velocity at the contact point (vn, vt
+// zero): what a bond needs at the end of its step when it has no dashpots.
+[[gnu::always_inline]] inline PairMotion pair_geometry(Vec3 d, double len, Vec3 va, Vec3 vb, Vec3 wa,
+                                                       Vec3 wb, double ra_s, double rb_s) {
+  PairMotion m;
+  m.n = (1.0 / len) * d;
+  const double arm_a = len * ra_s / (ra_s + rb_s);
+  m.ra = arm_a * m.n;
+  m.rb = -(len - arm_a) * m.n;
+  m.wa = wa;
+  m.wb = wb;
+  m.vrel_ab = vb - va;
+  m.vn = 0.0;
+  m.vt = {0.0, 0.0, 0.0};
+  return m;
+}
+
 // Formats a double the way users wrote it (shortest round-trip-ish form).
 std::string fmt_num(double v) {
   std::ostringstream s;
@@ -625,8 +642,13 @@ inline void FixBondBreakable::evaluate_bond(const AtomArrays &at, ListedBond &bo
   const Vec3 xa = load3(at.x[a]);
   const Vec3 d = load3(at.x[b]) - xa;
   const double len = std::sqrt(dot(d, d));
-  const PairMotion m = pair_motion(d, len, load3(at.v[a]), load3(at.v[b]), load3(at.omega[a]),
-                                   load3(at.omega[b]), at.radius[a], at.radius[b]);
+  // The relative motion at the end of the step is needed for the dashpots
+  // only; otherwise the geometry (n, the contact point) is enough.
+  const PairMotion m = damping_ > 0.0
+                           ? pair_motion(d, len, load3(at.v[a]), load3(at.v[b]), load3(at.omega[a]),
+                                         load3(at.omega[b]), at.radius[a], at.radius[b])
+                           : pair_geometry(d, len, load3(at.v[a]), load3(at.v[b]), load3(at.omega[a]),
+                                           load3(at.omega[b]), at.radius[a], at.radius[b]);
   const Vec3 n = m.n;
   const double dt = at.dt;
   Vec3 fs = load3(bond.fs);
@@ -645,9 +667,11 @@ inline void FixBondBreakable::evaluate_bond(const AtomArrays &at, ListedBond &bo
                                      at.radius[a], at.radius[b]);
     // Carry the stored shear force and bending moment with the bond plane,
     // onto the midpoint plane, then (after the increment) onto the end plane.
-    const double half_spin = 0.25 * (dot(m.wa, n) + dot(m.wb, n)) * dt;
-    fs = rotate_onto_plane(fs, h.n, half_spin);
-    mb = rotate_onto_plane(mb, h.n, half_spin);
+    // The spin about n: half with each move (applied once, at the end, a
+    // twisting pair gains 14 % of its energy in 11 turns).
+    const double spin = 0.5 * (dot(m.wa, n) + dot(m.wb, n)) * dt;
+    fs = rotate_onto_plane(fs, h.n, 0.5 * spin);
+    mb = rotate_onto_plane(mb, h.n, 0.5 * spin);
     // Potyondy & Cundall 2004, eq. 6: incremental shear force and moments.
     const Vec3 wrel = m.wb - m.wa;
     const double wn = dot(wrel, h.n);
@@ -655,8 +679,8 @@ inline void FixBondBreakable::evaluate_bond(const AtomArrays &at, ListedBond &bo
     fs = fs - ksa_dt * h.vt;                  // dF^s = -k^s A dU^s
     mb = mb - kni_dt * (wrel - wn * h.n);     // dM^s = -k^n I dtheta^s
     mt -= bond.ksj * wn * dt;                 // dM^n = -k^s J dtheta^n
-    fs = rotate_onto_plane(fs, n, half_spin);
-    mb = rotate_onto_plane(mb, n, half_spin);
+    fs = rotate_onto_plane(fs, n, 0.5 * spin);
+    mb = rotate_onto_plane(mb, n, 0.5 * spin);
     store3(bond.fs, fs);
     store3(bond.mb, mb);
     bond.mt = mt;
