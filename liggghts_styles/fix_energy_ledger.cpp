@@ -31,12 +31,14 @@ namespace {
 constexpr const char *kColumnNames =
     "step,time_s,ke_trans_J,ke_rot_J,numerical_J,bond_elastic_J,bond_released_J,bond_damping_J,"
     "bond_friction_J,wall_elastic_J,wall_damping_J,wall_friction_J,contact_elastic_J,"
-    "contact_dissipated_J,work_other_J,input_J,residual_J,max_speed_m_s,wall_overlap,residual_bonds_J,"
+    "contact_dissipated_J,work_other_J,input_J,residual_J,max_speed_m_s,wall_overlap,residual_"
+    "bonds_J,"
     "residual_wall_J";
 
 // Styles that add forces in post_force: the ledger must come before them.
-constexpr const char *kForceStyles[] = {"bond/breakable", "wall/halfspace", "wall/gran", "fluid/drag",
-                                        "gravity", "addforce", "setforce"};
+constexpr const char *kForceStyles[] = {"bond/breakable", "wall/halfspace", "wall/gran",
+                                        "fluid/drag",     "gravity",        "addforce",
+                                        "setforce"};
 
 }  // namespace
 
@@ -78,7 +80,8 @@ void FixEnergyLedger::parse_args(int narg, char **arg) {
       have_e = true;
     } else if (key == "poisson") {
       poisson_ = args.real("poisson", val);
-      if (!(poisson_ > -1.0 && poisson_ < 0.5)) fail(std::string("poisson must be in (-1, 0.5), got ") + val);
+      if (!(poisson_ > -1.0 && poisson_ < 0.5))
+        fail(std::string("poisson must be in (-1, 0.5), got ") + val);
       have_nu = true;
     } else if (key == "integrated") {
       integrated_ = val;
@@ -88,21 +91,25 @@ void FixEnergyLedger::parse_args(int narg, char **arg) {
       wall_id_ = val;
     } else if (key == "speed_bound") {
       speed_bound_ = args.real("speed_bound", val);
-      if (!(speed_bound_ >= 0.0)) fail(std::string("speed_bound must be >= 0 m/s (0: no check), got ") + val);
+      if (!(speed_bound_ >= 0.0))
+        fail(std::string("speed_bound must be >= 0 m/s (0: no check), got ") + val);
     } else if (key == "residual_bound") {
       residual_bound_ = args.real("residual_bound", val);
-      if (!(residual_bound_ >= 0.0)) fail(std::string("residual_bound must be >= 0 (0: no check), got ") + val);
+      if (!(residual_bound_ >= 0.0))
+        fail(std::string("residual_bound must be >= 0 (0: no check), got ") + val);
     } else if (key == "residual_floor") {
       residual_floor_ = args.real("residual_floor", val);
       if (!(residual_floor_ >= 0.0)) fail(std::string("residual_floor must be >= 0 J, got ") + val);
     } else {
       fail("unknown keyword '" + key +
-           "' (expected every, interval, file, youngs, poisson, integrated, bonds, wall, speed_bound, "
+           "' (expected every, interval, file, youngs, poisson, integrated, bonds, wall, "
+           "speed_bound, "
            "residual_bound, residual_floor)");
     }
     iarg += 2;
   }
-  if (!have_e || !have_nu) fail("youngs E and poisson NU of the elements are required (Hertz energy of contacts)");
+  if (!have_e || !have_nu)
+    fail("youngs E and poisson NU of the elements are required (Hertz energy of contacts)");
 }
 
 int FixEnergyLedger::setmask() { return POST_FORCE | END_OF_STEP | POST_RUN; }
@@ -123,21 +130,29 @@ void FixEnergyLedger::init() {
   }
   if (!bond_id_.empty()) {
     bonds_ = dynamic_cast<FixBondBreakable *>(modify->find_fix_id(bond_id_.c_str()));
-    if (!bonds_) error->all(FLERR, ("fix energy/ledger: bonds " + bond_id_ + ": no fix bond/breakable with that ID").c_str());
+    if (!bonds_)
+      error->all(FLERR,
+                 ("fix energy/ledger: bonds " + bond_id_ + ": no fix bond/breakable with that ID")
+                     .c_str());
   }
   if (!wall_id_.empty()) {
     wall_ = dynamic_cast<FixWallHalfspace *>(modify->find_fix_id(wall_id_.c_str()));
-    if (!wall_) error->all(FLERR, ("fix energy/ledger: wall " + wall_id_ + ": no fix wall/halfspace with that ID").c_str());
+    if (!wall_)
+      error->all(
+          FLERR,
+          ("fix energy/ledger: wall " + wall_id_ + ": no fix wall/halfspace with that ID").c_str());
   }
   check_order();
   if (interval_ > 0.0) every_ = std::max(1, static_cast<int>(std::lround(interval_ / update->dt)));
   global_freq = every_;
-  if (!force->pair) error->all(FLERR, "fix energy/ledger: needs a pair style (the element contacts)");
+  if (!force->pair)
+    error->all(FLERR, "fix energy/ledger: needs a pair style (the element contacts)");
   if (comm->me == 0 && !out_ && !file_.empty()) {
     out_ = fopen(file_.c_str(), started_ ? "a" : "w");
     if (!out_) error->one(FLERR, ("fix energy/ledger: cannot open file '" + file_ + "'").c_str());
     if (!started_) {
-      fprintf(out_, "# fix energy/ledger: energy of the run [J] (docs/styles/fix_energy_ledger.md)\n%s\n",
+      fprintf(out_,
+              "# fix energy/ledger: energy of the run [J] (docs/styles/fix_energy_ledger.md)\n%s\n",
               kColumnNames);
       fflush(out_);
     }
@@ -152,8 +167,9 @@ void FixEnergyLedger::check_order() const {
   for (int k = 0; k < me; ++k)
     for (const char *s : kForceStyles)
       if (modify->fix[k]->style && std::strcmp(modify->fix[k]->style, s) == 0) {
-        const std::string m = std::string("fix energy/ledger: must be defined before fix ") + modify->fix[k]->id +
-                              " (" + s + "): it reads the element contacts' forces before any fix adds its own";
+        const std::string m =
+            std::string("fix energy/ledger: must be defined before fix ") + modify->fix[k]->id +
+            " (" + s + "): it reads the element contacts' forces before any fix adds its own";
         error->all(FLERR, m.c_str());
       }
 }
@@ -162,11 +178,21 @@ void FixEnergyLedger::check_order() const {
 // after this one add theirs to the same arrays right after).
 void FixEnergyLedger::setup(int vflag) {
   post_force(vflag);
-  if (started_) return;
+  if (started_) {
+    // Between runs no force acts: kinetic energy that changed since the last
+    // step (a `velocity` or `set` command) came from nowhere. It goes into
+    // the residual, not into the other forces' work.
+    double t = 0.0, r = 0.0, s = 0.0;
+    local_kinetic(t, r, s);
+    injected_ += t + r - ke_last_;
+    ke_last_ = t + r;
+    return;
+  }
   pair_work_.start(local_pair_power(), update->dt);
   started_ = true;
   double t = 0.0, r = 0.0, s = 0.0;
   local_kinetic(t, r, s);
+  ke_last_ = t + r;
   double loc[2] = {t + r + s, local_contact_elastic()}, glob[2] = {0.0, 0.0};
   MPI_Allreduce(loc, glob, 2, MPI_DOUBLE, MPI_SUM, world);
   kinetic0_ = glob[0];
@@ -192,8 +218,8 @@ double FixEnergyLedger::local_pair_power() const {
   double p = 0.0;
   for (int i = 0; i < n; ++i) {
     const double *q = &fpair_[6 * i];
-    p += q[0] * v[i][0] + q[1] * v[i][1] + q[2] * v[i][2] + q[3] * omega[i][0] + q[4] * omega[i][1] +
-         q[5] * omega[i][2];
+    p += q[0] * v[i][0] + q[1] * v[i][1] + q[2] * v[i][2] + q[3] * omega[i][0] +
+         q[4] * omega[i][1] + q[5] * omega[i][2];
   }
   return p;
 }
@@ -212,10 +238,13 @@ void FixEnergyLedger::local_kinetic(double &trans, double &rot, double &shadow) 
     if (!(mask[i] & moved_)) continue;
     const double m = rmass[i], inertia = 0.4 * m * radius[i] * radius[i];
     trans += 0.5 * m * (v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2]);
-    rot += 0.5 * inertia * (omega[i][0] * omega[i][0] + omega[i][1] * omega[i][1] + omega[i][2] * omega[i][2]);
-    shadow -= dt2 / 8.0 *
-              ((f[i][0] * f[i][0] + f[i][1] * f[i][1] + f[i][2] * f[i][2]) / m +
-               (torque[i][0] * torque[i][0] + torque[i][1] * torque[i][1] + torque[i][2] * torque[i][2]) / inertia);
+    rot += 0.5 * inertia *
+           (omega[i][0] * omega[i][0] + omega[i][1] * omega[i][1] + omega[i][2] * omega[i][2]);
+    shadow -=
+        dt2 / 8.0 *
+        ((f[i][0] * f[i][0] + f[i][1] * f[i][1] + f[i][2] * f[i][2]) / m +
+         (torque[i][0] * torque[i][0] + torque[i][1] * torque[i][1] + torque[i][2] * torque[i][2]) /
+             inertia);
   }
 }
 
@@ -243,7 +272,8 @@ double FixEnergyLedger::local_contact_elastic() const {
       if (r2 >= rsum * rsum) continue;
       const double delta = rsum - std::sqrt(r2);
       const double reff = radius[i] * radius[j] / rsum;
-      e += (j < nlocal ? 1.0 : 0.5) * 8.0 / 15.0 * yeff * std::sqrt(reff) * delta * delta * std::sqrt(delta);
+      e += (j < nlocal ? 1.0 : 0.5) * 8.0 / 15.0 * yeff * std::sqrt(reff) * delta * delta *
+           std::sqrt(delta);
     }
   }
   return e;
@@ -253,21 +283,27 @@ double FixEnergyLedger::local_contact_elastic() const {
 // a sample every `every` steps.
 void FixEnergyLedger::end_of_step() {
   pair_work_.add(local_pair_power(), update->dt);
-  double **v = atom->v;
+  double **v = atom->v, **omega = atom->omega;
+  const double *rmass = atom->rmass, *radius = atom->radius;
   const int *mask = atom->mask;
   const double bound_sq = speed_bound_ * speed_bound_;
+  ke_last_ = 0.0;
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(mask[i] & moved_)) continue;
     const double s2 = v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2];
+    const double w2 =
+        omega[i][0] * omega[i][0] + omega[i][1] * omega[i][1] + omega[i][2] * omega[i][2];
+    ke_last_ += 0.5 * rmass[i] * (s2 + 0.4 * radius[i] * radius[i] * w2);
     vmax_sq_ = std::max(vmax_sq_, s2);
     if (speed_bound_ > 0.0 && s2 > bound_sq) {
       char m[640];
-      snprintf(m, sizeof(m),
-               "fix energy/ledger: element %d moves at %.4g m/s at step " BIGINT_FORMAT
-               " (t = %.6g s), above the speed bound %.4g m/s that the run's inputs allow: energy was "
-               "created, the run is invalid (the ledger so far: %s)",
-               atom->tag[i], std::sqrt(s2), update->ntimestep, update->get_cur_time(), speed_bound_,
-               file_.empty() ? "no file" : file_.c_str());
+      snprintf(
+          m, sizeof(m),
+          "fix energy/ledger: element %d moves at %.4g m/s at step " BIGINT_FORMAT
+          " (t = %.6g s), above the speed bound %.4g m/s that the run's inputs allow: energy was "
+          "created, the run is invalid (the ledger so far: %s)",
+          atom->tag[i], std::sqrt(s2), update->ntimestep, update->get_cur_time(), speed_bound_,
+          file_.empty() ? "no file" : file_.c_str());
       // Also on stderr: error->one aborts before the log file is flushed.
       fprintf(stderr, "ERROR on proc %d: %s\n", comm->me, m);
       fflush(stderr);
@@ -285,12 +321,11 @@ void FixEnergyLedger::post_run() {
 // Sums the terms over ranks (one reduction), closes the balance, checks the
 // residual, writes a row (rank 0).
 void FixEnergyLedger::sample(bool write) {
-  enum {
-    T = 0, R, S, CE, WP, WB, BE, BE0, BR, BD, BF, WW, WE, WE0, WD, WF, NSUM
-  };
+  enum { T = 0, R, S, CE, WP, WB, BE, BE0, BR, BD, BF, WW, WE, WE0, WD, WF, INJ, NSUM };
   double loc[NSUM] = {}, glob[NSUM] = {};
   local_kinetic(loc[T], loc[R], loc[S]);
   loc[CE] = local_contact_elastic();
+  loc[INJ] = injected_;
   // Exact velocity-Verlet work of each family: the trapezoid less its end
   // term dt^2/4 sum f.F/m (+ torques), energy_terms.h, over the group's atoms
   // (atoms moved at a set speed, such as platens, need no end term).
@@ -299,8 +334,8 @@ void FixEnergyLedger::sample(bool write) {
   const int np = std::min(atom->nlocal, static_cast<int>(fpair_.size() / 6));
   for (int i = 0; i < np; ++i)
     if (atom->mask[i] & moved_)
-      pair_end += mill::end_term(&fpair_[6 * i], &fpair_[6 * i + 3], atom->f[i], atom->torque[i], atom->rmass[i],
-                               atom->radius[i]);
+      pair_end += mill::end_term(&fpair_[6 * i], &fpair_[6 * i + 3], atom->f[i], atom->torque[i],
+                                 atom->rmass[i], atom->radius[i]);
   loc[WP] = pair_work_.value() - q * pair_end;
   if (bonds_) {
     const auto &b = bonds_->local_energy();
@@ -340,7 +375,9 @@ void FixEnergyLedger::sample(bool write) {
   // What the element contacts took and do not store.
   r[CONTACT_DISSIPATED] = -glob[WP] - (glob[CE] - contact_elastic0_);
   // The kinetic theorem: every other force did the rest of the work.
-  r[WORK_OTHER] = (glob[T] + glob[R] + glob[S] - kinetic0_) - glob[WP] - glob[WB] - glob[WW];
+  // (less what changed between runs, which no force did).
+  r[WORK_OTHER] =
+      (glob[T] + glob[R] + glob[S] - kinetic0_) - glob[WP] - glob[WB] - glob[WW] - glob[INJ];
   r[INPUT] = kinetic0_ + contact_elastic0_ + glob[BE0] + glob[WE0];
   double held = 0.0;
   for (int c = KE_TRANS; c <= CONTACT_DISSIPATED; ++c) held += r[c];
@@ -361,12 +398,14 @@ void FixEnergyLedger::sample(bool write) {
   if (residual_bound_ > 0.0 && std::fabs(r[RESIDUAL]) > residual_floor_ &&
       std::fabs(r[RESIDUAL]) > residual_bound_ * scale) {
     char m[640];
-    snprintf(m, sizeof(m),
-             "fix energy/ledger: the energy balance does not close at step " BIGINT_FORMAT
-             " (t = %.6g s): residual %.4g J is %.3g%% of the energy put in (%.4g J), above the bound "
-             "%.3g%%: energy was created or lost by the integration, the run is invalid (ledger: %s)",
-             update->ntimestep, update->get_cur_time(), r[RESIDUAL], 100.0 * std::fabs(r[RESIDUAL]) / scale, scale,
-             100.0 * residual_bound_, file_.empty() ? "no file" : file_.c_str());
+    snprintf(
+        m, sizeof(m),
+        "fix energy/ledger: the energy balance does not close at step " BIGINT_FORMAT
+        " (t = %.6g s): residual %.4g J is %.3g%% of the energy put in (%.4g J), above the bound "
+        "%.3g%%: energy was created or lost by the integration, the run is invalid (ledger: %s)",
+        update->ntimestep, update->get_cur_time(), r[RESIDUAL],
+        100.0 * std::fabs(r[RESIDUAL]) / scale, scale, 100.0 * residual_bound_,
+        file_.empty() ? "no file" : file_.c_str());
     if (comm->me == 0) {
       fprintf(stderr, "ERROR: %s\n", m);
       fflush(stderr);

@@ -41,53 +41,55 @@ class FixEnergyLedger : public Fix {
 
   // The ledger's columns, in file order (docs/styles/fix_energy_ledger.md).
   enum Column {
-    KE_TRANS = 0,      // translational kinetic energy now
-    KE_ROT,            // rotational kinetic energy now
-    NUMERICAL,         // velocity Verlet's shadow term, sum |F|^2 dt^2/(8m) + |T|^2 dt^2/(8I)
-    BOND_ELASTIC,      // stored in intact bonds (and pressed contacts of broken bonds)
-    BOND_RELEASED,     // stored in bonds when they broke, cumulative
-    BOND_DAMPING,      // taken by bond dashpots, cumulative
-    BOND_FRICTION,     // taken by Coulomb slip of broken-bond contacts, cumulative
-    WALL_ELASTIC,      // stored in the rigid surface's contacts now
-    WALL_DAMPING,      // taken by its dashpots, cumulative
-    WALL_FRICTION,     // taken by sliding on it, cumulative
-    CONTACT_ELASTIC,   // stored in the normal springs of element contacts now (Hertz)
+    KE_TRANS = 0,        // translational kinetic energy now
+    KE_ROT,              // rotational kinetic energy now
+    NUMERICAL,           // velocity Verlet's shadow term, sum |F|^2 dt^2/(8m) + |T|^2 dt^2/(8I)
+    BOND_ELASTIC,        // stored in intact bonds (and pressed contacts of broken bonds)
+    BOND_RELEASED,       // stored in bonds when they broke, cumulative
+    BOND_DAMPING,        // taken by bond dashpots, cumulative
+    BOND_FRICTION,       // taken by Coulomb slip of broken-bond contacts, cumulative
+    WALL_ELASTIC,        // stored in the rigid surface's contacts now
+    WALL_DAMPING,        // taken by its dashpots, cumulative
+    WALL_FRICTION,       // taken by sliding on it, cumulative
+    CONTACT_ELASTIC,     // stored in the normal springs of element contacts now (Hertz)
     CONTACT_DISSIPATED,  // taken by element contacts: damping, friction (what they do not store)
-    WORK_OTHER,        // work of every other force (moving walls, gas, gravity, platens)
-    INPUT,             // energy at the start: kinetic + stored
-    RESIDUAL,          // input + other work - everything above
-    MAX_SPEED,         // fastest element since the last sample [m/s]
-    WALL_OVERLAP,      // largest overlap on the rigid surface / element radius so far
-    RESIDUAL_BONDS,    // the bonds' share of the residual: work + stored change + released + taken
-    RESIDUAL_WALL,     // the rigid surface's share, likewise
+    WORK_OTHER,          // work of every other force (moving walls, gas, gravity, platens)
+    INPUT,               // energy at the start: kinetic + stored
+    RESIDUAL,            // input + other work - everything above
+    MAX_SPEED,           // fastest element since the last sample [m/s]
+    WALL_OVERLAP,        // largest overlap on the rigid surface / element radius so far
+    RESIDUAL_BONDS,  // the bonds' share of the residual: work + stored change + released + taken
+    RESIDUAL_WALL,   // the rigid surface's share, likewise
     NCOLUMN
   };
 
  private:
-  int every_ = 1000;                 // steps between samples
-  double interval_ = 0.0;            // time between samples [s]; sets every_ at init
-  std::string file_;                 // the ledger file (CSV), rank 0
-  std::string bond_id_, wall_id_;    // fixes whose terms are read
-  std::string integrated_;           // group velocity Verlet moves (default: the fix's)
-  int moved_ = 0;                    // its bit, found at each init
+  int every_ = 1000;                     // steps between samples
+  double interval_ = 0.0;                // time between samples [s]; sets every_ at init
+  std::string file_;                     // the ledger file (CSV), rank 0
+  std::string bond_id_, wall_id_;        // fixes whose terms are read
+  std::string integrated_;               // group velocity Verlet moves (default: the fix's)
+  int moved_ = 0;                        // its bit, found at each init
   double youngs_ = 0.0, poisson_ = 0.0;  // element E [Pa], nu (Hertz energy of contacts)
-  double speed_bound_ = 0.0;         // fastest element allowed [m/s]; 0 = no check
-  double residual_bound_ = 0.0;      // |residual| / (input + |other work|) allowed; 0 = none
-  double residual_floor_ = 0.0;      // J below which the residual is not checked
+  double speed_bound_ = 0.0;             // fastest element allowed [m/s]; 0 = no check
+  double residual_bound_ = 0.0;          // |residual| / (input + |other work|) allowed; 0 = none
+  double residual_floor_ = 0.0;          // J below which the residual is not checked
 
   FixBondBreakable *bonds_ = nullptr;
   FixWallHalfspace *wall_ = nullptr;
   FILE *out_ = nullptr;
 
-  std::vector<double> fpair_;        // this step's pair forces and torques, 6 per atom
-  mill::PowerIntegral pair_work_;    // work of the element contacts
-  double input_ = 0.0;               // input energy (first setup) [J]
+  std::vector<double> fpair_;      // this step's pair forces and torques, 6 per atom
+  mill::PowerIntegral pair_work_;  // work of the element contacts
+  double input_ = 0.0;             // input energy (first setup) [J]
   double contact_elastic0_ = 0.0, bond_elastic0_ = 0.0, wall_elastic0_ = 0.0;
-  double kinetic0_ = 0.0;            // kinetic energy incl. shadow term at the start [J]
+  double kinetic0_ = 0.0;  // kinetic energy incl. shadow term at the start [J]
   bool started_ = false;
-  double vmax_sq_ = 0.0;             // fastest element since the last sample, squared
+  double vmax_sq_ = 0.0;   // fastest element since the last sample, squared
+  double ke_last_ = 0.0;   // this rank's kinetic energy at the last step's end [J]
+  double injected_ = 0.0;  // this rank's kinetic energy changed between runs [J]
   bigint last_sample_ = -1;
-  double row_[NCOLUMN] = {};         // the last sample (global values)
+  double row_[NCOLUMN] = {};  // the last sample (global values)
 
   void parse_args(int narg, char **arg);
   double local_pair_power() const;

@@ -109,7 +109,8 @@ void FixWallHalfspace::parse_args(int narg, char **arg) {
   if (!have_e || !have_ew) fail("youngs and wall_youngs are required (Pa)");
   if (!have_nu || !have_nuw) fail("poisson and wall_poisson are required");
   for (double nu : {poisson_, wall_poisson_})
-    if (!(nu > -1.0 && nu < 0.5)) fail("a Poisson's ratio must be in (-1, 0.5), got " + std::to_string(nu));
+    if (!(nu > -1.0 && nu < 0.5))
+      fail("a Poisson's ratio must be in (-1, 0.5), got " + std::to_string(nu));
 }
 
 int FixWallHalfspace::setmask() { return POST_FORCE | END_OF_STEP; }
@@ -272,7 +273,8 @@ double FixWallHalfspace::local_end_term(int groupbit) const {
   double s = 0.0;
   for (const Touch &t : touches_)
     if (atom->mask[t.i] & groupbit)
-      s += mill::end_term(t.f, t.t, atom->f[t.i], atom->torque[t.i], atom->rmass[t.i], atom->radius[t.i]);
+      s += mill::end_term(t.f, t.t, atom->f[t.i], atom->torque[t.i], atom->rmass[t.i],
+                          atom->radius[t.i]);
   return s;
 }
 

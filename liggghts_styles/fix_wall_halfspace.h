@@ -15,8 +15,8 @@
 
 #include <vector>
 
-#include "fix.h"
 #include "energy_terms.h"
+#include "fix.h"
 
 namespace LAMMPS_NS {
 
@@ -51,8 +51,9 @@ class FixWallHalfspace : public Fix {
     double elastic = 0.0;         // stored in the contacts now (normal + tangential springs)
     double elastic0 = 0.0;        // stored at the start of the first run
     mill::PowerIntegral damping;  // dissipated by the normal and tangential dashpots
-    double friction = 0.0;        // dissipated by Coulomb sliding and the spring's stiffness change, cumulative
-    double max_overlap = 0.0;     // largest overlap / element radius so far [-]
+    double friction =
+        0.0;  // dissipated by Coulomb sliding and the spring's stiffness change, cumulative
+    double max_overlap = 0.0;  // largest overlap / element radius so far [-]
   };
   const Energy &local_energy() const { return energy_; }
   // This rank's work on the elements and dashpot losses up to the current
