@@ -99,6 +99,8 @@ std::string JoinCsv(const std::vector<std::string>& cells) {
   return out;
 }
 
+}  // namespace
+
 // Splits one CSV line on commas (the files hold numbers and names only).
 std::vector<std::string> SplitCsv(const std::string& line) {
   std::vector<std::string> cells;
@@ -108,6 +110,8 @@ std::vector<std::string> SplitCsv(const std::string& line) {
   if (!line.empty() && line.back() == ',') cells.emplace_back();
   return cells;
 }
+
+namespace {
 
 // Appends rows to a CSV with the given header: copies the existing file (whose
 // header must match) plus the rows to path.tmp, then renames it over path.

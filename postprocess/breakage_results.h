@@ -15,6 +15,10 @@
 
 namespace mill::post {
 
+// Splits one CSV line on commas (the project's CSVs hold numbers and names only,
+// no quoting); a trailing comma gives an empty last cell.
+std::vector<std::string> SplitCsv(const std::string& line);
+
 // Writes text to path.tmp, then renames it over path: whole or absent.
 // Throws PostError naming the file when it cannot be written.
 void WriteTextAtomically(const std::string& path, const std::string& text);

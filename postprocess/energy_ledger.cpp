@@ -25,16 +25,6 @@ constexpr const char* kComment =
 // the fix writes 10 significant digits, so a sound row closes to ~1e-9.
 constexpr double kBalanceTolerance = 1e-6;
 
-// Splits one CSV line on commas (the ledger holds names and numbers only).
-std::vector<std::string> SplitFields(const std::string& line) {
-  std::vector<std::string> cells;
-  std::string cell;
-  std::istringstream ss(line);
-  while (std::getline(ss, cell, ',')) cells.push_back(cell);
-  if (!line.empty() && line.back() == ',') cells.emplace_back();
-  return cells;
-}
-
 // Joins strings with commas.
 std::string JoinFields(const std::vector<std::string>& cells) {
   std::string out;
@@ -181,11 +171,11 @@ EnergyLedger ReadEnergyLedger(const std::string& path) {
   if (!NextDataLine(in, line, line_no)) {
     throw PostError(fmt::format("{}: no header line, expected '{}'", path, RequiredNames()));
   }
-  l.columns = SplitFields(line);
+  l.columns = SplitCsv(line);
   CheckHeader(path, line_no, l.columns);
   l.values.assign(l.columns.size(), {});
   while (NextDataLine(in, line, line_no)) {
-    const auto cells = SplitFields(line);
+    const auto cells = SplitCsv(line);
     if (cells.size() != l.columns.size()) {
       throw PostError(fmt::format("{}:{}: {} values, the header has {}", path, line_no,
                                   cells.size(), l.columns.size()));
