@@ -323,8 +323,8 @@ std::vector<std::string> LinkNames(hid_t group, const std::string& where) {
   H5Check(H5Gget_info(group, &info), fmt::format("{}: group info", where));
   std::vector<std::string> names;
   for (hsize_t k = 0; k < info.nlinks; ++k) {
-    const ssize_t len = H5Lget_name_by_idx(group, ".", H5_INDEX_NAME, H5_ITER_INC, k, nullptr, 0,
-                                           H5P_DEFAULT);
+    const ssize_t len =
+        H5Lget_name_by_idx(group, ".", H5_INDEX_NAME, H5_ITER_INC, k, nullptr, 0, H5P_DEFAULT);
     if (len < 0) throw PostError(fmt::format("{}: cannot list", where));
     std::string name(static_cast<std::size_t>(len) + 1, '\0');
     H5Lget_name_by_idx(group, ".", H5_INDEX_NAME, H5_ITER_INC, k, name.data(), name.size(),
@@ -436,8 +436,8 @@ ImpactResult AnalyseImpact(const std::vector<Element>& elements, const std::vect
   r.new_surface_m2 = NewSurfaceArea(diameters, d_ref);
 
   for (const Element& e : elements) {
-    s.element_d_rel_max = std::max(
-        s.element_d_rel_max, EquivalentDiameter(e.mass, spec.density_kg_m3) / d_ref);
+    s.element_d_rel_max =
+        std::max(s.element_d_rel_max, EquivalentDiameter(e.mass, spec.density_kg_m3) / d_ref);
   }
   s.t10_resolved = s.element_d_rel_max < 0.1;
   if (!s.t10_resolved) {
@@ -560,7 +560,8 @@ std::vector<FractionRow> ReadFractionsCsv(const std::string& path) {
       throw PostError(fmt::format("{}:{}: fraction_index: expected a whole number >= 0, got '{}'",
                                   path, line_no, cells[3]));
     }
-    rows.push_back({{v[0], v[1], static_cast<int>(v[2])}, static_cast<int>(v[3]), v[4], v[5], v[6]});
+    rows.push_back(
+        {{v[0], v[1], static_cast<int>(v[2])}, static_cast<int>(v[3]), v[4], v[5], v[6]});
   }
   return rows;
 }
@@ -694,7 +695,8 @@ void WriteJkFitH5(const std::string& path, const std::vector<JkFitRecord>& recor
   const hid_t raw = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
   if (raw < 0) throw PostError(fmt::format("{}: cannot open as HDF5 for writing", path));
   H5Id file(raw, H5Fclose, "open");
-  if (H5Lexists(file, "jk_fit", H5P_DEFAULT) > 0) H5Check(H5Ldelete(file, "jk_fit", H5P_DEFAULT), "delete /jk_fit");
+  if (H5Lexists(file, "jk_fit", H5P_DEFAULT) > 0)
+    H5Check(H5Ldelete(file, "jk_fit", H5P_DEFAULT), "delete /jk_fit");
   H5Id top(MakeGroup(file, "jk_fit"), H5Gclose, "group /jk_fit");
   WriteStringAttr(top, "relation",
                   "t10 = A (1 - exp(-b Ecs)), Ecs = V^2/2 in kWh/t (Napier-Munn et al. 1996, "
@@ -710,9 +712,13 @@ void WriteJkFitH5(const std::string& path, const std::vector<JkFitRecord>& recor
     WriteDataset(g, "repeat", r.repeat, {n}, "1");
     WriteDataset(g, "used", r.used, {n}, "1");
     const JkFit& f = r.fit.pooled;
-    WriteStringAttr(g, "status", f.ok ? (f.note.empty() ? "fitted" : "fitted: " + f.note) : "not fitted: " + f.reason);
+    WriteStringAttr(
+        g, "status",
+        f.ok ? (f.note.empty() ? "fitted" : "fitted: " + f.note) : "not fitted: " + f.reason);
     if (!f.ok) continue;
-    auto scalar = [&](const char* name, double v, const char* unit) { WriteDataset(g, name, std::vector<double>{v}, {1}, unit); };
+    auto scalar = [&](const char* name, double v, const char* unit) {
+      WriteDataset(g, name, std::vector<double>{v}, {1}, unit);
+    };
     scalar("A", f.a_percent, "%");
     scalar("b", f.b_t_per_kwh, "t/kWh");
     scalar("A_times_b", f.ab(), "% t/kWh");

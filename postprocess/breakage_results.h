@@ -108,9 +108,9 @@ std::vector<ImpactSummary> ReadSummaryCsv(const std::string& path);
 // One row of fractions.csv: the mass fraction of one size fraction of one impact.
 struct FractionRow {
   ImpactConditions conditions;
-  int index = 0;             // fraction index, 0 = finest
-  double d_low_rel = 0.0;    // lower edge, d/D
-  double d_high_rel = 0.0;   // upper edge, d/D
+  int index = 0;            // fraction index, 0 = finest
+  double d_low_rel = 0.0;   // lower edge, d/D
+  double d_high_rel = 0.0;  // upper edge, d/D
   double mass_fraction = 0.0;
 };
 
