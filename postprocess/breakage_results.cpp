@@ -503,9 +503,10 @@ void AppendFractionsCsv(const std::string& path, const ImpactResult& result) {
   AppendCsvRows(path, JoinCsv(FractionsCsvColumns()), rows);
 }
 
-// The number in one CSV cell, or a PostError naming file, line and column.
-static double ParseCsvNumber(const std::string& path, long line_no, const std::string& column,
-                             const std::string& cell) {
+// The number in one CSV cell (finite only if `finite`), or a PostError naming
+// file, line and column.
+double ParseCsvNumber(const std::string& path, long line_no, const std::string& column,
+                      const std::string& cell, bool finite) {
   std::size_t used = 0;
   double v = 0.0;
   try {
@@ -513,9 +514,9 @@ static double ParseCsvNumber(const std::string& path, long line_no, const std::s
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used == 0 || used != cell.size()) {
-    throw PostError(
-        fmt::format("{}:{}: {}: expected a number, got '{}'", path, line_no, column, cell));
+  if (used == 0 || used != cell.size() || (finite && !std::isfinite(v))) {
+    throw PostError(fmt::format("{}:{}: {}: expected a {}number, got '{}'", path, line_no, column,
+                                finite ? "finite " : "", cell));
   }
   return v;
 }

@@ -19,6 +19,11 @@ namespace mill::post {
 // no quoting); a trailing comma gives an empty last cell.
 std::vector<std::string> SplitCsv(const std::string& line);
 
+// The number in one CSV cell, or a PostError naming the file, line and column;
+// with finite, NaN and infinities are refused too.
+double ParseCsvNumber(const std::string& path, long line_no, const std::string& column,
+                      const std::string& cell, bool finite = false);
+
 // Writes text to path.tmp, then renames it over path: whole or absent.
 // Throws PostError naming the file when it cannot be written.
 void WriteTextAtomically(const std::string& path, const std::string& text);

@@ -71,23 +71,6 @@ void CheckHeader(const std::string& path, long line_no, const std::vector<std::s
   }
 }
 
-// The finite number in one cell, or a PostError naming file, line and column.
-double ParseValue(const std::string& path, long line_no, const std::string& column,
-                  const std::string& cell) {
-  std::size_t used = 0;
-  double v = 0.0;
-  try {
-    v = std::stod(cell, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != cell.size() || !std::isfinite(v)) {
-    throw PostError(
-        fmt::format("{}:{}: {}: expected a finite number, got '{}'", path, line_no, column, cell));
-  }
-  return v;
-}
-
 // input + |work_other| of row k: the energy the balance is measured against.
 double Scale(const EnergyLedger& l, std::size_t k) {
   return l.column("input_J")[k] + std::abs(l.column("work_other_J")[k]);
@@ -181,7 +164,7 @@ EnergyLedger ReadEnergyLedger(const std::string& path) {
                                   cells.size(), l.columns.size()));
     }
     for (std::size_t c = 0; c < cells.size(); ++c)
-      l.values[c].push_back(ParseValue(path, line_no, l.columns[c], cells[c]));
+      l.values[c].push_back(ParseCsvNumber(path, line_no, l.columns[c], cells[c], true));
     l.lines.push_back(line_no);
   }
   if (l.lines.empty()) {

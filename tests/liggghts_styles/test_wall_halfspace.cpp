@@ -145,22 +145,29 @@ Outcome run_crossing(const std::string &name, const std::vector<Sphere> &atoms, 
 //       3 x the impact speed. The half-space: no element behind the plane
 //       and the fastest element below 3 x the impact speed.
 // ===========================================================================
+
+// The z force on one element at rest (run 0) from LIGGGHTS's primitive plane
+// (fz[0]) and from wall/halfspace (fz[1]).
+static void static_force_z(const Sphere &e, const char *tag, double fz[2]) {
+  for (Wall w : {Wall::kPrimitive, Wall::kHalfspace}) {
+    const std::string dir = make_run_dir(tag);
+    const auto r = run_wall_deck(dir, {e}, w, 0.5, 0.5,
+                                 "timestep 1e-9\nrun 0\nvariable fz equal fz[1]\n"
+                                 "print \"${fz}\" file fz.txt\n");
+    ASSERT_EQ(r.exit_code, 0) << r.screen;
+    const auto row = read_line(dir + "/fz.txt");
+    ASSERT_FALSE(row.empty());
+    fz[w == Wall::kHalfspace] = row[0];
+  }
+}
 TEST(WallHalfspace, OneSidedWhereThePrimitivePlaneIsTwoSided) {
   // a) static force on a centre 0.2 r below the plane.
   {
     Sphere s;
     s.x = {0.0, 0.0, -0.2 * kR};
     double fz[2] = {0.0, 0.0};
-    for (Wall w : {Wall::kPrimitive, Wall::kHalfspace}) {
-      const std::string dir = make_run_dir("wh_static");
-      const auto r = run_wall_deck(dir, {s}, w, 0.5, 0.5,
-                                   "timestep 1e-9\nrun 0\nvariable fz equal fz[1]\n"
-                                   "print \"${fz}\" file fz.txt\n");
-      ASSERT_EQ(r.exit_code, 0) << r.screen;
-      const auto row = read_line(dir + "/fz.txt");
-      ASSERT_FALSE(row.empty());
-      fz[w == Wall::kHalfspace] = row[0];
-    }
+    static_force_z(s, "wh_static", fz);
+    if (HasFatalFailure()) return;
     const double f_prim = -hertz_force(kR, 0.8 * kR), f_half = hertz_force(kR, 1.2 * kR);
     std::printf(
         "centre 0.2 r behind the plane: F_z primitive %.9e N (analytic %.9e N, overlap 0.8 r), "
@@ -271,16 +278,8 @@ TEST(WallHalfspace, MatchesLiggghtsWallGranBelowCrossing) {
     Sphere p;
     p.x = {0.0, 0.0, kR * (1.0 - frac)};
     double fz[2] = {0.0, 0.0};
-    for (Wall w : {Wall::kPrimitive, Wall::kHalfspace}) {
-      const std::string dir = make_run_dir("wh_force");
-      const auto r = run_wall_deck(dir, {p}, w, 0.5, 0.5,
-                                   "timestep 1e-9\nrun 0\nvariable fz equal fz[1]\n"
-                                   "print \"${fz}\" file fz.txt\n");
-      ASSERT_EQ(r.exit_code, 0) << r.screen;
-      const auto row = read_line(dir + "/fz.txt");
-      ASSERT_FALSE(row.empty());
-      fz[w == Wall::kHalfspace] = row[0];
-    }
+    static_force_z(p, "wh_force", fz);
+    if (HasFatalFailure()) return;
     const double f = hertz_force(kR, frac * kR);
     std::printf(
         "normal force at overlap %.2f r: wall/gran %.9e N, wall/halfspace %.9e N, 4/3 Y* sqrt(r) "
