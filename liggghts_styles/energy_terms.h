@@ -22,6 +22,18 @@ inline double end_term(const double *f, const double *t, const double *ftot, con
          (t[0] * ttot[0] + t[1] * ttot[1] + t[2] * ttot[2]) / inertia;
 }
 
+// Power of per-atom forces and torques f6 (6 per atom: force, torque) on the
+// first n atoms at velocities v and angular velocities omega [W].
+inline double power6(const double *f6, int n, double *const *v, double *const *omega) {
+  double p = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double *q = f6 + 6 * i;
+    p += q[0] * v[i][0] + q[1] * v[i][1] + q[2] * v[i][2] + q[3] * omega[i][0] +
+         q[4] * omega[i][1] + q[5] * omega[i][2];
+  }
+  return p;
+}
+
 struct PowerIntegral {
   double cum = 0.0;   // sum of P dt, with the first sample weighted 1/2 [J]
   double last = 0.0;  // the last power sampled [W]

@@ -419,15 +419,8 @@ double FixBondBreakable::local_end_term(int groupbit) const {
 
 // Power of this step's bond forces and torques on the owned atoms [W].
 double FixBondBreakable::bond_power() const {
-  double **v = atom->v, **omega = atom->omega;
   const int n = std::min(atom->nlocal, static_cast<int>(fbond_.size() / 6));
-  double p = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const double *fb = &fbond_[6 * i];
-    p += fb[0] * v[i][0] + fb[1] * v[i][1] + fb[2] * v[i][2] + fb[3] * omega[i][0] +
-         fb[4] * omega[i][1] + fb[5] * omega[i][2];
-  }
-  return p;
+  return mill::power6(fbond_.data(), n, atom->v, atom->omega);
 }
 
 // Writes the bond dump at the end of every run.

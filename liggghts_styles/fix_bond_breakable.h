@@ -65,12 +65,12 @@ class FixBondBreakable : public Fix {
   // This rank's share of the bonds' energy terms [J] (bonds computed here,
   // counted once); summed over ranks by fix energy/ledger at its samples.
   struct Energy {
-    mill::PowerIntegral work;   // work the bonds and contacts did on the elements
-    double elastic = 0.0;       // stored now: intact bonds and pressed contacts
-    double elastic0 = 0.0;      // stored at the start of the first run
-    double released = 0.0;      // stored in bonds at the step they broke, cumulative
+    mill::PowerIntegral work;     // work the bonds and contacts did on the elements
+    double elastic = 0.0;         // stored now: intact bonds and pressed contacts
+    double elastic0 = 0.0;        // stored at the start of the first run
+    double released = 0.0;        // stored in bonds at the step they broke, cumulative
     mill::PowerIntegral damping;  // taken by the dashpots (power at the full steps)
-    double friction = 0.0;      // taken by Coulomb slip of contacts, cumulative
+    double friction = 0.0;        // taken by Coulomb slip of contacts, cumulative
   };
   const Energy &local_energy() const { return ledger_; }
   // This rank's work of the bonds up to the current step, whether or not
@@ -81,6 +81,8 @@ class FixBondBreakable : public Fix {
   // sum of end_term() over this step's bond forces on the atoms of groupbit,
   // the ones velocity Verlet integrates (energy_terms.h).
   double local_end_term(int groupbit) const;
+  // This step's bond forces and torques on the owned atoms (6 per atom).
+  const std::vector<double> &ledger_forces() const { return fbond_; }
 
  private:
   // Parameters (SI units, see the doc page).
@@ -137,34 +139,34 @@ class FixBondBreakable : public Fix {
   // exchanged, sorted or re-ghosted (a neighbour-list build), a bond breaks,
   // storage grows or the time step changes.
   struct ListedBond {
-    int a, b;          // atom indices, a = lower tag (b may be a ghost image)
-    int i;             // owned atom whose slot holds the history
-    int j;             // the partner if it is owned here, else -1
-    int slot_i;        // slot of the bond on i
-    int slot_j;        // slot on j (j >= 0), else -1
-    bool i_lower;      // tag[i] < partner tag
+    int a, b;      // atom indices, a = lower tag (b may be a ghost image)
+    int i;         // owned atom whose slot holds the history
+    int j;         // the partner if it is owned here, else -1
+    int slot_i;    // slot of the bond on i
+    int slot_j;    // slot on j (j >= 0), else -1
+    bool i_lower;  // tag[i] < partner tag
     // History, canonical frame (columns FS, MB, MT, STATE of the slots):
     double fs[3], mb[3], mt, state;
     // Constants of the bond (radii, masses and L0 do not change during a run):
-    double l0;                           // initial length [m]
+    double l0;                            // initial length [m]
     double rbond, inv_area, inv_inertia;  // disc radius [m], 1/A [1/m^2], 1/I [1/m^4]
-    double kna, ksa;                     // kn A, ks A [N/m]
-    double kni, ksj;                     // kn I, ks J [N m]
-    double cn, cs;                       // dashpots (damping > 0) [N s/m]
-    double drop_len;                     // a contact is dropped beyond this length [m]
+    double kna, ksa;                      // kn A, ks A [N/m]
+    double kni, ksj;                      // kn I, ks J [N m]
+    double cn, cs;                        // dashpots (damping > 0) [N s/m]
+    double drop_len;                      // a contact is dropped beyond this length [m]
   };
   std::vector<ListedBond> list_;
   bool list_valid_ = false;
   bool history_dirty_ = false;  // list_ holds history not yet in the slots
   bigint list_ncalls_ = -1;     // neighbor->ncalls when the list was built
   int list_nlocal_ = -1, list_nghost_ = -1;
-  double list_dt_ = 0.0;        // update->dt when the list was built
+  double list_dt_ = 0.0;  // update->dt when the list was built
   // Energy ledger: this step's bond forces and torques on the owned atoms
   // (6 per atom, f then torque), kept from post_force to end_of_step.
   Energy ledger_;
   std::vector<double> fbond_;
   bool ledger_started_ = false;
-  bigint ledger_step_ = -1;  // the step whose power the work holds
+  bigint ledger_step_ = -1;   // the step whose power the work holds
   double bond_power() const;  // sum of F.v + T.omega of fbond_ [W]
   // With damping: each listed bond's dashpot force on b this step (3 per
   // entry, zero for bonds counted elsewhere), and the power they take at the
@@ -182,8 +184,7 @@ class FixBondBreakable : public Fix {
   void parse_args(int narg, char **arg);
   void create_bonds();
   void compute_bonds(bool advance);
-  void evaluate_bond(const AtomArrays &at, ListedBond &bond, bool advance,
-                     BondResult &out) const;
+  void evaluate_bond(const AtomArrays &at, ListedBond &bond, bool advance, BondResult &out) const;
   bool evaluate_contact(const AtomArrays &at, ListedBond &bond, bool advance,
                         BondResult &out) const;
   void store_history();

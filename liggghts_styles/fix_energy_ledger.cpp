@@ -13,6 +13,8 @@
 #include "comm.h"
 #include "error.h"
 #include "fix_bond_breakable.h"
+#include "fix_energy_work.h"
+#include "fix_property_global.h"
 #include "fix_wall_halfspace.h"
 #include "force.h"
 #include "group.h"
@@ -31,9 +33,12 @@ namespace {
 constexpr const char *kColumnNames =
     "step,time_s,ke_trans_J,ke_rot_J,numerical_J,bond_elastic_J,bond_released_J,bond_damping_J,"
     "bond_friction_J,wall_elastic_J,wall_damping_J,wall_friction_J,contact_elastic_J,"
-    "contact_dissipated_J,work_other_J,input_J,residual_J,max_speed_m_s,wall_overlap,residual_"
+    "contact_damping_J,contact_friction_J,work_other_J,input_J,residual_J,max_speed_m_s,wall_"
+    "overlap,residual_"
     "bonds_J,"
     "residual_wall_J";
+
+constexpr double kPi = 3.14159265358979323846;
 
 // Styles that add forces in post_force: the ledger must come before them.
 constexpr const char *kForceStyles[] = {"bond/breakable", "wall/halfspace", "wall/gran",
@@ -45,7 +50,7 @@ constexpr const char *kForceStyles[] = {"bond/breakable", "wall/halfspace", "wal
 FixEnergyLedger::FixEnergyLedger(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg) {
   parse_args(narg, arg);
   vector_flag = 1;
-  size_vector = NCOLUMN;
+  size_vector = NCOLUMN;  // and one per fix energy/work, known at init
   global_freq = every_;
   extvector = 0;
 }
@@ -143,6 +148,8 @@ void FixEnergyLedger::init() {
           ("fix energy/ledger: wall " + wall_id_ + ": no fix wall/halfspace with that ID").c_str());
   }
   check_order();
+  find_parts();
+  find_restitution();
   if (interval_ > 0.0) every_ = std::max(1, static_cast<int>(std::lround(interval_ / update->dt)));
   global_freq = every_;
   if (!force->pair)
@@ -151,9 +158,11 @@ void FixEnergyLedger::init() {
     out_ = fopen(file_.c_str(), started_ ? "a" : "w");
     if (!out_) error->one(FLERR, ("fix energy/ledger: cannot open file '" + file_ + "'").c_str());
     if (!started_) {
+      std::string header = kColumnNames;
+      for (const FixEnergyWork *w : parts_) header += ",work_" + w->part_name() + "_J";
       fprintf(out_,
               "# fix energy/ledger: energy of the run [J] (docs/styles/fix_energy_ledger.md)\n%s\n",
-              kColumnNames);
+              header.c_str());
       fflush(out_);
     }
   }
@@ -174,6 +183,73 @@ void FixEnergyLedger::check_order() const {
       }
 }
 
+// The fixes energy/work after this one, in deck order: each measures the
+// forces added between the snapshot before it (this fix's, or the previous
+// part's) and its own. One before this fix has no snapshot to start from.
+void FixEnergyLedger::find_parts() {
+  std::vector<FixEnergyWork *> found;
+  bool after = false;
+  for (int k = 0; k < modify->nfix; ++k) {
+    if (modify->fix[k] == this) {
+      after = true;
+      continue;
+    }
+    auto *w = dynamic_cast<FixEnergyWork *>(modify->fix[k]);
+    if (!w) continue;
+    if (!after)
+      error->all(FLERR, ("fix energy/ledger: fix energy/work " + std::string(w->id) +
+                         " is defined before the ledger; define it after the force fixes whose "
+                         "work it measures, and after the ledger")
+                            .c_str());
+    found.push_back(w);
+  }
+  if (started_ && found.size() != parts_.size())
+    error->all(FLERR,
+               "fix energy/ledger: a fix energy/work was added or removed between runs; the "
+               "ledger's columns are fixed at the first run");
+  parts_ = found;
+  // Each part: the snapshot before it, and the fixes in between whose forces
+  // the ledger books itself (bonds, the rigid surface).
+  auto index_of = [this](const Fix *f) {
+    for (int k = 0; k < modify->nfix; ++k)
+      if (modify->fix[k] == f) return k;
+    return -1;
+  };
+  const std::vector<double> *previous = &fpair_;
+  int from = index_of(this);
+  for (FixEnergyWork *w : parts_) {
+    if (w->measures_mesh()) continue;
+    const int to = index_of(w);
+    const int ib = bonds_ ? index_of(bonds_) : -1, iw = wall_ ? index_of(wall_) : -1;
+    w->set_previous(previous);
+    w->set_booked(ib > from && ib < to ? bonds_ : nullptr, iw > from && iw < to ? wall_ : nullptr);
+    previous = &w->snapshot();
+    from = to;
+  }
+  size_vector = NCOLUMN + static_cast<int>(parts_.size());
+  part_row_.assign(parts_.size(), 0.0);
+}
+
+// The normal dashpot of the pair style's Hertz contacts (LIGGGHTS
+// normal_model_hertz): gamma_n = -2 sqrt(5/6) beta sqrt(S_n m*), S_n =
+// 2 Y* sqrt(R* delta), beta = ln e / sqrt(ln^2 e + pi^2), with e the pair's
+// coefficientRestitution (property/global) of the two elements' types
+// (Tsuji et al. 1992). Read at each init.
+void FixEnergyLedger::find_restitution() {
+  ntypes_ = atom->ntypes;
+  beta_.assign(static_cast<size_t>(ntypes_ + 1) * (ntypes_ + 1), 0.0);
+  auto *cor = static_cast<FixPropertyGlobal *>(modify->find_fix_property(
+      "coefficientRestitution", "property/global", "peratomtypepair", ntypes_, ntypes_, style));
+  for (int i = 1; i <= ntypes_; ++i)
+    for (int j = 1; j <= ntypes_; ++j) {
+      const double e = cor->compute_array(i - 1, j - 1);
+      if (!(e > 0.0 && e <= 1.0))
+        error->all(FLERR, "fix energy/ledger: coefficientRestitution must be in (0, 1]");
+      const double le = std::log(e);
+      beta_[static_cast<size_t>(i) * (ntypes_ + 1) + j] = le / std::sqrt(le * le + kPi * kPi);
+    }
+}
+
 // First run: the energy at the start. Every run: the pair forces (the fixes
 // after this one add theirs to the same arrays right after).
 void FixEnergyLedger::setup(int vflag) {
@@ -189,6 +265,7 @@ void FixEnergyLedger::setup(int vflag) {
     return;
   }
   pair_work_.start(local_pair_power(), update->dt);
+  damp_work_.start(local_damping_power(), update->dt);
   started_ = true;
   double t = 0.0, r = 0.0, s = 0.0;
   local_kinetic(t, r, s);
@@ -209,19 +286,66 @@ void FixEnergyLedger::post_force(int /*vflag*/) {
     p[0] = f[i][0], p[1] = f[i][1], p[2] = f[i][2];
     p[3] = torque[i][0], p[4] = torque[i][1], p[5] = torque[i][2];
   }
+  contact_damping_forces();
+}
+
+// The normal-dashpot part of this step's pair forces, per owned atom: the
+// law of find_restitution at this step's positions and half-step velocities,
+// the values the pair style used. A pair with a ghost is listed on both
+// ranks (newton off): each adds the force on its own atom.
+void FixEnergyLedger::contact_damping_forces() {
+  const int nlocal = atom->nlocal;
+  fdamp_.assign(3 * static_cast<size_t>(nlocal), 0.0);
+  const NeighList *list = force->pair->list;
+  if (!list || !list->ilist) return;
+  double **x = atom->x, **v = atom->v;
+  const double *radius = atom->radius, *rmass = atom->rmass;
+  const int *type = atom->type;
+  const double yeff = FixWallHalfspace::effective_youngs(youngs_, poisson_, youngs_, poisson_);
+  const double sqrt56 = std::sqrt(5.0 / 6.0);
+  for (int ii = 0; ii < list->inum; ++ii) {
+    const int i = list->ilist[ii];
+    const int *jlist = list->firstneigh[i];
+    for (int jj = 0; jj < list->numneigh[i]; ++jj) {
+      const int j = jlist[jj] & NEIGHMASK;
+      const double d[3] = {x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]};
+      const double rsum = radius[i] + radius[j];
+      const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+      if (r2 >= rsum * rsum || r2 == 0.0) continue;
+      const double r = std::sqrt(r2), delta = rsum - r;
+      const double beta = beta_[static_cast<size_t>(type[i]) * (ntypes_ + 1) + type[j]];
+      if (beta == 0.0) continue;
+      const double n[3] = {d[0] / r, d[1] / r, d[2] / r};
+      const double vn =
+          (v[i][0] - v[j][0]) * n[0] + (v[i][1] - v[j][1]) * n[1] + (v[i][2] - v[j][2]) * n[2];
+      const double reff = radius[i] * radius[j] / rsum;
+      const double meff = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);
+      const double sn = 2.0 * yeff * std::sqrt(reff * delta);
+      const double gamman = -2.0 * sqrt56 * beta * std::sqrt(sn * meff);
+      const double fd = -gamman * vn;  // on i along n; on j the opposite
+      for (int c = 0; c < 3; ++c) {
+        fdamp_[3 * i + c] += fd * n[c];
+        if (j < nlocal) fdamp_[3 * j + c] -= fd * n[c];
+      }
+    }
+  }
+}
+
+// Power of the contacts' normal dashpots on the owned atoms at the full-step
+// velocities [W].
+double FixEnergyLedger::local_damping_power() const {
+  double **v = atom->v;
+  const int n = std::min(atom->nlocal, static_cast<int>(fdamp_.size() / 3));
+  double p = 0.0;
+  for (int i = 0; i < n; ++i)
+    p += fdamp_[3 * i] * v[i][0] + fdamp_[3 * i + 1] * v[i][1] + fdamp_[3 * i + 2] * v[i][2];
+  return p;
 }
 
 // Power of the pair forces on the owned atoms at the full-step velocities [W].
 double FixEnergyLedger::local_pair_power() const {
-  double **v = atom->v, **omega = atom->omega;
   const int n = std::min(atom->nlocal, static_cast<int>(fpair_.size() / 6));
-  double p = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const double *q = &fpair_[6 * i];
-    p += q[0] * v[i][0] + q[1] * v[i][1] + q[2] * v[i][2] + q[3] * omega[i][0] +
-         q[4] * omega[i][1] + q[5] * omega[i][2];
-  }
-  return p;
+  return mill::power6(fpair_.data(), n, atom->v, atom->omega);
 }
 
 // Kinetic energy of the group's owned elements (translation, rotation with
@@ -283,6 +407,7 @@ double FixEnergyLedger::local_contact_elastic() const {
 // a sample every `every` steps.
 void FixEnergyLedger::end_of_step() {
   pair_work_.add(local_pair_power(), update->dt);
+  damp_work_.add(local_damping_power(), update->dt);
   double **v = atom->v, **omega = atom->omega;
   const double *rmass = atom->rmass, *radius = atom->radius;
   const int *mask = atom->mask;
@@ -321,8 +446,9 @@ void FixEnergyLedger::post_run() {
 // Sums the terms over ranks (one reduction), closes the balance, checks the
 // residual, writes a row (rank 0).
 void FixEnergyLedger::sample(bool write) {
-  enum { T = 0, R, S, CE, WP, WB, BE, BE0, BR, BD, BF, WW, WE, WE0, WD, WF, INJ, NSUM };
-  double loc[NSUM] = {}, glob[NSUM] = {};
+  enum { T = 0, R, S, CE, WP, WDP, WB, BE, BE0, BR, BD, BF, WW, WE, WE0, WD, WF, INJ, NSUM };
+  const size_t nsum = NSUM + parts_.size();
+  std::vector<double> loc(nsum, 0.0), glob(nsum, 0.0);
   local_kinetic(loc[T], loc[R], loc[S]);
   loc[CE] = local_contact_elastic();
   loc[INJ] = injected_;
@@ -330,13 +456,22 @@ void FixEnergyLedger::sample(bool write) {
   // term dt^2/4 sum f.F/m (+ torques), energy_terms.h, over the group's atoms
   // (atoms moved at a set speed, such as platens, need no end term).
   const double q = 0.25 * update->dt * update->dt;
-  double pair_end = 0.0;
+  double pair_end = 0.0, damp_end = 0.0;
+  const double no_torque[3] = {0.0, 0.0, 0.0};
   const int np = std::min(atom->nlocal, static_cast<int>(fpair_.size() / 6));
+  const int nd = std::min(atom->nlocal, static_cast<int>(fdamp_.size() / 3));
   for (int i = 0; i < np; ++i)
     if (atom->mask[i] & moved_)
       pair_end += mill::end_term(&fpair_[6 * i], &fpair_[6 * i + 3], atom->f[i], atom->torque[i],
                                  atom->rmass[i], atom->radius[i]);
+  for (int i = 0; i < nd; ++i)
+    if (atom->mask[i] & moved_)
+      damp_end += mill::end_term(&fdamp_[3 * i], no_torque, atom->f[i], atom->torque[i],
+                                 atom->rmass[i], atom->radius[i]);
   loc[WP] = pair_work_.value() - q * pair_end;
+  loc[WDP] = damp_work_.value() - q * damp_end;
+  for (size_t k = 0; k < parts_.size(); ++k)
+    loc[NSUM + k] = parts_[k]->local_work_now() - q * parts_[k]->local_end_term(moved_);
   if (bonds_) {
     const auto &b = bonds_->local_energy();
     loc[WB] = bonds_->local_work_now() - q * bonds_->local_end_term(moved_);
@@ -354,7 +489,7 @@ void FixEnergyLedger::sample(bool write) {
     loc[WE0] = w.elastic0;
     loc[WF] = w.friction;
   }
-  MPI_Allreduce(loc, glob, NSUM, MPI_DOUBLE, MPI_SUM, world);
+  MPI_Allreduce(loc.data(), glob.data(), static_cast<int>(nsum), MPI_DOUBLE, MPI_SUM, world);
   const double lmax[2] = {vmax_sq_, wall_ ? wall_->local_energy().max_overlap : 0.0};
   double gmax[2] = {0.0, 0.0};
   MPI_Allreduce(lmax, gmax, 2, MPI_DOUBLE, MPI_MAX, world);
@@ -372,25 +507,29 @@ void FixEnergyLedger::sample(bool write) {
   r[WALL_DAMPING] = glob[WD];
   r[WALL_FRICTION] = glob[WF];
   r[CONTACT_ELASTIC] = glob[CE];
-  // What the element contacts took and do not store.
-  r[CONTACT_DISSIPATED] = -glob[WP] - (glob[CE] - contact_elastic0_);
+  // What the element contacts took and do not store: their normal dashpots,
+  // and the rest (tangential: slip, dashpot, rolling resistance).
+  r[CONTACT_DAMPING] = -glob[WDP];
+  r[CONTACT_FRICTION] = -glob[WP] - (glob[CE] - contact_elastic0_) - r[CONTACT_DAMPING];
   // The kinetic theorem: every other force did the rest of the work.
   // (less what changed between runs, which no force did).
   r[WORK_OTHER] =
       (glob[T] + glob[R] + glob[S] - kinetic0_) - glob[WP] - glob[WB] - glob[WW] - glob[INJ];
   r[INPUT] = kinetic0_ + contact_elastic0_ + glob[BE0] + glob[WE0];
   double held = 0.0;
-  for (int c = KE_TRANS; c <= CONTACT_DISSIPATED; ++c) held += r[c];
+  for (int c = KE_TRANS; c <= CONTACT_FRICTION; ++c) held += r[c];
   r[RESIDUAL] = r[INPUT] + r[WORK_OTHER] - held;
   r[MAX_SPEED] = std::sqrt(gmax[0]);
   r[WALL_OVERLAP] = gmax[1];
   r[RESIDUAL_BONDS] = -(glob[WB] + glob[BE] - glob[BE0] + glob[BR] + glob[BD] + glob[BF]);
   r[RESIDUAL_WALL] = -(glob[WW] + glob[WE] - glob[WE0] + glob[WD] + glob[WF]);
+  for (size_t k = 0; k < parts_.size(); ++k) part_row_[k] = glob[NSUM + k];
   last_sample_ = update->ntimestep;
 
   if (write && out_) {
     fprintf(out_, BIGINT_FORMAT ",%.10g", update->ntimestep, update->get_cur_time());
     for (double c : row_) fprintf(out_, ",%.10g", c);
+    for (double c : part_row_) fprintf(out_, ",%.10g", c);
     fputc('\n', out_);
     fflush(out_);
   }
@@ -414,5 +553,9 @@ void FixEnergyLedger::sample(bool write) {
   }
 }
 
-// Global outputs 1..NCOLUMN: the last sample's columns (cached).
-double FixEnergyLedger::compute_vector(int n) { return (n >= 0 && n < NCOLUMN) ? row_[n] : 0.0; }
+// Global outputs 1..NCOLUMN + parts: the last sample's columns (cached).
+double FixEnergyLedger::compute_vector(int n) {
+  if (n >= 0 && n < NCOLUMN) return row_[n];
+  const size_t k = static_cast<size_t>(n - NCOLUMN);
+  return (n >= NCOLUMN && k < part_row_.size()) ? part_row_[k] : 0.0;
+}

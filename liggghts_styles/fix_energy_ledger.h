@@ -23,6 +23,7 @@ namespace LAMMPS_NS {
 
 class FixBondBreakable;
 class FixWallHalfspace;
+class FixEnergyWork;
 
 class FixEnergyLedger : public Fix {
  public:
@@ -41,25 +42,27 @@ class FixEnergyLedger : public Fix {
 
   // The ledger's columns, in file order (docs/styles/fix_energy_ledger.md).
   enum Column {
-    KE_TRANS = 0,        // translational kinetic energy now
-    KE_ROT,              // rotational kinetic energy now
-    NUMERICAL,           // velocity Verlet's shadow term, sum |F|^2 dt^2/(8m) + |T|^2 dt^2/(8I)
-    BOND_ELASTIC,        // stored in intact bonds (and pressed contacts of broken bonds)
-    BOND_RELEASED,       // stored in bonds when they broke, cumulative
-    BOND_DAMPING,        // taken by bond dashpots, cumulative
-    BOND_FRICTION,       // taken by Coulomb slip of broken-bond contacts, cumulative
-    WALL_ELASTIC,        // stored in the rigid surface's contacts now
-    WALL_DAMPING,        // taken by its dashpots, cumulative
-    WALL_FRICTION,       // taken by sliding on it, cumulative
-    CONTACT_ELASTIC,     // stored in the normal springs of element contacts now (Hertz)
-    CONTACT_DISSIPATED,  // taken by element contacts: damping, friction (what they do not store)
-    WORK_OTHER,          // work of every other force (moving walls, gas, gravity, platens)
-    INPUT,               // energy at the start: kinetic + stored
-    RESIDUAL,            // input + other work - everything above
-    MAX_SPEED,           // fastest element since the last sample [m/s]
-    WALL_OVERLAP,        // largest overlap on the rigid surface / element radius so far
-    RESIDUAL_BONDS,  // the bonds' share of the residual: work + stored change + released + taken
-    RESIDUAL_WALL,   // the rigid surface's share, likewise
+    KE_TRANS = 0,      // translational kinetic energy now
+    KE_ROT,            // rotational kinetic energy now
+    NUMERICAL,         // velocity Verlet's shadow term, sum |F|^2 dt^2/(8m) + |T|^2 dt^2/(8I)
+    BOND_ELASTIC,      // stored in intact bonds (and pressed contacts of broken bonds)
+    BOND_RELEASED,     // stored in bonds when they broke, cumulative
+    BOND_DAMPING,      // taken by bond dashpots, cumulative
+    BOND_FRICTION,     // taken by Coulomb slip of broken-bond contacts, cumulative
+    WALL_ELASTIC,      // stored in the rigid surface's contacts now
+    WALL_DAMPING,      // taken by its dashpots, cumulative
+    WALL_FRICTION,     // taken by sliding on it, cumulative
+    CONTACT_ELASTIC,   // stored in the normal springs of element contacts now (Hertz)
+    CONTACT_DAMPING,   // taken by the normal dashpots of element contacts, cumulative
+    CONTACT_FRICTION,  // taken tangentially: Coulomb slip, tangential dashpot, rolling resistance
+    WORK_OTHER,        // work of every other force (moving walls, gas, gravity, platens);
+                       // its parts measured by fix energy/work follow the last column
+    INPUT,             // energy at the start: kinetic + stored
+    RESIDUAL,          // input + other work - everything above
+    MAX_SPEED,         // fastest element since the last sample [m/s]
+    WALL_OVERLAP,      // largest overlap on the rigid surface / element radius so far
+    RESIDUAL_BONDS,    // the bonds' share of the residual: work + stored change + released + taken
+    RESIDUAL_WALL,     // the rigid surface's share, likewise
     NCOLUMN
   };
 
@@ -77,11 +80,16 @@ class FixEnergyLedger : public Fix {
 
   FixBondBreakable *bonds_ = nullptr;
   FixWallHalfspace *wall_ = nullptr;
+  std::vector<FixEnergyWork *> parts_;  // fix energy/work after this one, in deck order
   FILE *out_ = nullptr;
 
   std::vector<double> fpair_;      // this step's pair forces and torques, 6 per atom
   mill::PowerIntegral pair_work_;  // work of the element contacts
-  double input_ = 0.0;             // input energy (first setup) [J]
+  std::vector<double> fdamp_;      // this step's normal-dashpot forces of the contacts, 3 per atom
+  mill::PowerIntegral damp_work_;  // their work
+  std::vector<double> beta_;       // ln e / sqrt(ln^2 e + pi^2) per type pair (row-major, 1-based)
+  int ntypes_ = 0;
+  double input_ = 0.0;  // input energy (first setup) [J]
   double contact_elastic0_ = 0.0, bond_elastic0_ = 0.0, wall_elastic0_ = 0.0;
   double kinetic0_ = 0.0;  // kinetic energy incl. shadow term at the start [J]
   bool started_ = false;
@@ -89,10 +97,15 @@ class FixEnergyLedger : public Fix {
   double ke_last_ = 0.0;   // this rank's kinetic energy at the last step's end [J]
   double injected_ = 0.0;  // this rank's kinetic energy changed between runs [J]
   bigint last_sample_ = -1;
-  double row_[NCOLUMN] = {};  // the last sample (global values)
+  double row_[NCOLUMN] = {};      // the last sample (global values)
+  std::vector<double> part_row_;  // and its work_NAME_J columns
 
   void parse_args(int narg, char **arg);
   double local_pair_power() const;
+  double local_damping_power() const;
+  void find_restitution();
+  void find_parts();
+  void contact_damping_forces();
   double local_contact_elastic() const;
   void local_kinetic(double &trans, double &rot, double &shadow) const;
   void sample(bool write);

@@ -278,6 +278,16 @@ double FixWallHalfspace::local_end_term(int groupbit) const {
   return s;
 }
 
+void FixWallHalfspace::subtract_forces(std::vector<double> &f6) const {
+  const int n = static_cast<int>(f6.size() / 6);
+  for (const Touch &t : touches_)
+    if (t.i < n)
+      for (int c = 0; c < 3; ++c) {
+        f6[6 * t.i + c] -= t.f[c];
+        f6[6 * t.i + 3 + c] -= t.t[c];
+      }
+}
+
 void FixWallHalfspace::local_work_now(double &work, double &damping) const {
   if (step_ == update->ntimestep) {
     work = energy_.work.value();

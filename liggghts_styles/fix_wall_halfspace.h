@@ -62,6 +62,9 @@ class FixWallHalfspace : public Fix {
   // sum of end_term() over this step's wall forces on the atoms of groupbit,
   // the ones velocity Verlet integrates (energy_terms.h).
   double local_end_term(int groupbit) const;
+  // Takes this step's forces and torques of the surface off a per-atom array
+  // (6 per atom: force, torque), for fix energy/work.
+  void subtract_forces(std::vector<double> &f6) const;
 
   // Contact law of one element on the wall (LIGGGHTS's hertz model; public
   // for the analytic tests). Effective Young's and shear moduli [Pa] and the

@@ -4,6 +4,7 @@
 
 #include "fix_bond_breakable.h"
 #include "fix_energy_ledger.h"
+#include "fix_energy_work.h"
 #include "fix_fluid_drag.h"
 #include "fix_impact_recorder.h"
 #include "fix_wall_halfspace.h"
@@ -55,6 +56,8 @@ std::vector<std::string> register_mill_styles(LAMMPS_NS::LAMMPS *lmp) {
   names.emplace_back(LAMMPS_NS::FixWallHalfspace::style_name());
   (*fix_map)[LAMMPS_NS::FixEnergyLedger::style_name()] = &create_fix<LAMMPS_NS::FixEnergyLedger>;
   names.emplace_back(LAMMPS_NS::FixEnergyLedger::style_name());
+  (*fix_map)[LAMMPS_NS::FixEnergyWork::style_name()] = &create_fix<LAMMPS_NS::FixEnergyWork>;
+  names.emplace_back(LAMMPS_NS::FixEnergyWork::style_name());
   return names;
 }
 

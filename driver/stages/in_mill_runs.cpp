@@ -28,7 +28,7 @@ using post::kPi;
 constexpr double kG = 9.81;
 // 1: first version (issue 14).
 // 2: hub of 24 facets, skin of one mean element radius.
-constexpr int kInMillDeckVersion = 3;  // the energy ledger, midpoint bond increments
+constexpr int kInMillDeckVersion = 4;  // the walls in two fixes, each force's work measured
 // Facets of the flywheel's hub circle in the in-mill runs (see run_in_mill).
 constexpr int kHubFacets = 24;
 // Neighbour skin in mean element radii: the turning flywheel forces a list

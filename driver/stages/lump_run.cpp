@@ -20,6 +20,7 @@
 #include "jobs/job_store.h"
 #include "jobs/output_checks.h"
 #include "progress.h"
+#include "stages/stage_util.h"
 
 namespace mill {
 namespace fs = std::filesystem;
@@ -88,13 +89,7 @@ void write_fragments_vtp(const fs::path& file, const post::DumpSnapshot& snap,
 // The run's energy ledger (ledger.csv, fix energy/ledger) and its summary,
 // whose figures also go into the impact's summary row.
 void read_energy_ledger(const LumpRun& run, LumpRunResult& a) {
-  const fs::path file = run.work / "ledger.csv";
-  if (!fs::exists(file))
-    throw std::runtime_error(fmt::format(
-        "{}: missing: the deck wrote no energy ledger (expected `fix energy/ledger ... file "
-        "ledger.csv`, docs/styles/fix_energy_ledger.md); log: {}",
-        file.string(), (run.work / "liggghts.log").string()));
-  a.ledger = post::ReadEnergyLedger(file.string());
+  a.ledger = read_run_ledger(run.work);
   a.energy = post::SummariseLedger(a.ledger);
   post::ImpactSummary& s = a.result.summary;
   s.comminution_efficiency = a.energy.comminution_efficiency;

@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <stdexcept>
+
 namespace mill {
 
 nlohmann::json case_keys(const config::Document& doc, const std::vector<std::string>& prefixes) {
@@ -17,7 +19,8 @@ nlohmann::json ore_keys(const config::Document& ore) {
   nlohmann::json all = ore.to_json(), out = nlohmann::json::object();
   for (auto it = all.begin(); it != all.end(); ++it)
     if (it.key() != "name" && it.key() != "source" && it.key().rfind("calibrated.", 0) != 0 &&
-        it.key().rfind("jk.", 0) != 0) out[it.key()] = it.value();
+        it.key().rfind("jk.", 0) != 0)
+      out[it.key()] = it.value();
   return out;
 }
 
@@ -25,6 +28,17 @@ std::string rpm_label(double rpm) { return fmt::format("rpm{:g}", rpm); }
 
 std::string impact_label(double velocity, double angle, int repeat) {
   return fmt::format("v{:g}_a{:g}_r{}", velocity, angle, repeat);
+}
+
+// <workdir>/ledger.csv, or an error naming it and the run's log.
+post::EnergyLedger read_run_ledger(const std::filesystem::path& workdir) {
+  const std::filesystem::path file = workdir / "ledger.csv";
+  if (!std::filesystem::exists(file))
+    throw std::runtime_error(fmt::format(
+        "{}: missing: the deck wrote no energy ledger (expected `fix energy/ledger ... file "
+        "ledger.csv`, docs/styles/fix_energy_ledger.md); log: {}",
+        file.string(), (workdir / "liggghts.log").string()));
+  return post::ReadEnergyLedger(file.string());
 }
 
 }  // namespace mill

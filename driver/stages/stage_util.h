@@ -1,12 +1,14 @@
-// Small helpers shared by the stage files: canonical job inputs, labels.
+// Small helpers shared by the stage files: canonical job inputs, labels, a
+// run's energy ledger.
 #pragma once
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
-
 #include <string>
 #include <vector>
 
 #include "config/case_config.h"
+#include "postprocess/energy_ledger.h"
 
 namespace mill {
 
@@ -18,5 +20,10 @@ nlohmann::json ore_keys(const config::Document& ore);
 std::string rpm_label(double rpm);
 // "v150_a90_r0", "v4.5_a45_r2": folder label of an impact condition.
 std::string impact_label(double velocity, double angle, int repeat);
+// The energy ledger a bonded-lump deck wrote in its run folder (ledger.csv,
+// fix energy/ledger), read after the run. Throws naming the file and the
+// run's log when the deck wrote none, PostError naming the file (and line)
+// when it does not parse.
+post::EnergyLedger read_run_ledger(const std::filesystem::path& workdir);
 
 }  // namespace mill

@@ -97,7 +97,7 @@ TEST_F(TinyCampaign, EnergyLedgerOfEveryImpact) {
   };
   const auto slow = energy("v1_a90_r0"), fast = energy("v150_a90_r0");
   for (const auto& e : {slow, fast}) {
-    for (const char* k : {"input_J", "ke_trans_J", "bond_released_J", "contact_dissipated_J", "residual_fraction",
+    for (const char* k : {"input_J", "ke_trans_J", "bond_released_J", "contact_damping_J", "contact_friction_J", "residual_fraction",
                           "max_element_speed_m_s", "max_element_speed_time_s", "wall_overlap_max",
                           "comminution_efficiency", "new_surface_m2", "energy_per_new_surface_J_m2"})
       EXPECT_TRUE(e.contains(k)) << k;

@@ -1,6 +1,7 @@
 // The calibrate stage end to end with real LIGGGHTS runs: the two virtual lab
-// tests on a tiny specimen, the fitting loop recovering bond parameters that
-// are known to reach a synthetic target, and the ore card's own calibration.
+// tests on a tiny specimen with their energy ledgers, the fitting loop
+// recovering bond parameters that are known to reach a synthetic target, and
+// the ore card's own calibration.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -11,11 +12,13 @@
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "config/case_config.h"
-#include "stages/material.h"
-
 #include "e2e_util.h"
+#include "stages/material.h"
 
 namespace fs = std::filesystem;
 
@@ -74,6 +77,36 @@ TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
   EXPECT_NE(b.origin.find("calibrated"), std::string::npos) << b.origin;
   EXPECT_DOUBLE_EQ(b.modulus, y["calibrated"]["bond_modulus"].as<double>());
   EXPECT_NE(slurp(*dir_ / "calibrate" / "report.md").find("| E (GPa) |"), std::string::npos);
+
+  // Every lab run's energy ledger: the platens put energy in and the balance
+  // closes; report.md tabulates them.
+  const std::vector<std::pair<std::string, nlohmann::json>> runs = {
+      {"it1_ucs", r["iterations"][0]["energy"]["ucs"]},
+      {"it1_brazilian", r["iterations"][0]["energy"]["brazilian"]},
+      {"rate_check_ucs", r["rate_check"]["energy"]}};
+  for (const auto& [run, e] : runs) {
+    ASSERT_TRUE(e.is_object()) << run << ": " << r.dump(2);
+    for (const char* k :
+         {"input_J", "work_other_J", "bond_released_J", "residual_J", "residual_fraction",
+          "residual_fraction_max", "max_element_speed_m_s", "comminution_efficiency"})
+      EXPECT_TRUE(e.contains(k) && e[k].is_number()) << run << ": " << k << " in " << e.dump();
+    EXPECT_LT(std::abs(e["residual_fraction_max"].get<double>()), 0.01) << run << ": " << e.dump();
+    EXPECT_GT(e["input_J"].get<double>() + e["work_other_J"].get<double>(), 0.0)
+        << run << ": " << e.dump();
+    EXPECT_GE(e["bond_released_J"].get<double>(), 0.0) << run << ": " << e.dump();
+  }
+  const auto& worst = r["energy"];
+  EXPECT_EQ(worst["lab_runs"].get<int>(), 3) << worst.dump();
+  EXPECT_LT(worst["worst_residual_fraction_max"].get<double>(), 0.01) << worst.dump();
+  const std::string worst_run = worst["worst_run"].get<std::string>();
+  EXPECT_TRUE(worst_run == "it1_ucs" || worst_run == "it1_brazilian" ||
+              worst_run == "rate_check_ucs")
+      << worst_run;
+  const std::string md = slurp(*dir_ / "calibrate" / "report.md");
+  EXPECT_NE(md.find("## Energy ledger"), std::string::npos) << md;
+  for (const char* row : {"| it1_ucs * |", "| it1_brazilian * |", "| rate_check_ucs |"})
+    EXPECT_NE(md.find(row), std::string::npos) << row << " in\n" << md;
+  EXPECT_NE(md.find("Largest residual of any lab run: "), std::string::npos) << md;
 
   // A rerun skips the done job.
   const int st = orchestrate(

@@ -50,9 +50,13 @@ struct Ledger {
     for (const char *c :
          {"ke_trans_J", "ke_rot_J", "numerical_J", "bond_elastic_J", "bond_released_J",
           "bond_damping_J", "bond_friction_J", "wall_elastic_J", "wall_damping_J",
-          "wall_friction_J", "contact_elastic_J", "contact_dissipated_J"})
+          "wall_friction_J", "contact_elastic_J", "contact_damping_J", "contact_friction_J"})
       s += at(k, c);
     return s;
+  }
+  // What the element contacts took in row k: damping + friction [J].
+  double contact_lost(size_t k) const {
+    return at(k, "contact_damping_J") + at(k, "contact_friction_J");
   }
 };
 
@@ -196,10 +200,9 @@ TEST(EnergyLedger, HighSpeedImpactConservesWithoutDamping) {
   for (size_t k = 0; k < l.rows.size(); ++k) {
     worst_res = std::max(worst_res, std::fabs(l.at(k, "residual_J")) / input);
     worst_other = std::max(worst_other, std::fabs(l.at(k, "work_other_J")) / input);
-    const bool touch =
-        l.at(k, "wall_elastic_J") > 0.0 || l.at(k, "contact_elastic_J") > 0.0 ||
-        (k > 0 && (l.at(k, "wall_friction_J") != l.at(k - 1, "wall_friction_J") ||
-                   l.at(k, "contact_dissipated_J") != l.at(k - 1, "contact_dissipated_J")));
+    const bool touch = l.at(k, "wall_elastic_J") > 0.0 || l.at(k, "contact_elastic_J") > 0.0 ||
+                       (k > 0 && (l.at(k, "wall_friction_J") != l.at(k - 1, "wall_friction_J") ||
+                                  l.contact_lost(k) != l.contact_lost(k - 1)));
     if (touch) last_touch = l.at(k, "step");
   }
   const size_t n = l.rows.size() - 1;
@@ -212,13 +215,13 @@ TEST(EnergyLedger, HighSpeedImpactConservesWithoutDamping) {
       "intact bonds %.0f, last touch at step %.0f of %d, max overlap/r %.3f\n",
       std::sqrt(v0[0] * v0[0] + v0[2] * v0[2]), read_scalar(dir + "/dt.txt"), input, e0, worst_res,
       l.last("residual_bonds_J"), l.last("residual_wall_J"), worst_other, final_rel,
-      l.last("bond_released_J"), l.last("wall_friction_J"), l.last("contact_dissipated_J"),
+      l.last("bond_released_J"), l.last("wall_friction_J"), l.contact_lost(l.rows.size() - 1),
       read_scalar(dir + "/intact.txt"), last_touch, steps, l.last("wall_overlap"));
   EXPECT_NEAR(input / e0, 1.0, 1e-9);  // input = 1/2 M v0^2, round-off (1e-9)
   // Non-vacuous: the lump hit the surface, broke bonds and its pieces rubbed.
   EXPECT_GT(l.last("wall_overlap"), 0.05);
   EXPECT_GT(l.last("bond_released_J"), 0.01 * input);
-  EXPECT_GT(l.last("contact_dissipated_J"), 0.01 * input);
+  EXPECT_GT(l.contact_lost(l.rows.size() - 1), 0.01 * input);
   EXPECT_LT(last_touch, 0.8 * steps) << "pieces still touching: window too short";
   EXPECT_LT(worst_res, 1e-3);             // bound: residual below 0.1 % of the input
   EXPECT_LT(worst_other, 1e-9);           // no other force: round-off
@@ -305,8 +308,9 @@ TEST(EnergyLedger, BondDashpotMatchesDecay) {
   for (size_t k = 0; k < l.rows.size(); ++k) {
     e.emplace_back(l.at(k, "time_s"),
                    l.at(k, "ke_trans_J") + l.at(k, "ke_rot_J") + l.at(k, "bond_elastic_J"));
-    contact = std::max(
-        {contact, l.at(k, "contact_elastic_J"), std::fabs(l.at(k, "contact_dissipated_J"))});
+    contact =
+        std::max({contact, l.at(k, "contact_elastic_J"), std::fabs(l.at(k, "contact_damping_J")),
+                  std::fabs(l.at(k, "contact_friction_J"))});
   }
   auto energy_at = [&e](double t) {
     for (size_t k = 1; k < e.size(); ++k)
@@ -484,4 +488,134 @@ TEST(EnergyLedger, MustComeBeforeForceFixes) {
               names ? "yes" : "no");
   EXPECT_NE(r.exit_code, 0) << r.screen;
   EXPECT_TRUE(names) << r.screen;
+}
+
+// ===========================================================================
+// 5. Two free elements (no bonds, no surface) collide at relative speed
+//    2 m/s with element restitution e. Head on (impact parameter 0): the
+//    contact's normal dashpot takes all the kinetic energy lost,
+//    contact_damping_J = 1/2 m* (v0^2 - v1^2) with v1 the relative speed read
+//    from the atoms (1e-5 relative: the dashpot force is LIGGGHTS's own at
+//    the half step, its work a trapezoid, O(dt^2)), contact_friction_J stays
+//    below 1e-5 of it (nothing acts tangentially), and v1/v0 = e (1e-3, as
+//    for the surface). Oblique (impact parameter 0.6 r, friction 0.5): the
+//    normal relative motion of two spheres is driven by the normal force
+//    only, so contact_damping_J equals the loss of 1/2 m* vn^2 along the
+//    normal at first touch (1 %: the normal turns during contact), and the
+//    tangential losses (slip, tangential dashpot) are contact_friction_J,
+//    over 1 % of the loss. In both, damping + friction is the kinetic
+//    energy lost, rotation included (1e-6).
+//    Step 2e-9 s, about 1/2000 of the contact time.
+// ===========================================================================
+TEST(EnergyLedger, ContactDampingMatchesCollisionLoss) {
+  const double u = 1.0, m = sphere_mass(kR), mstar = 0.5 * m;
+  for (double e : {0.3, 0.7}) {
+    for (double b : {0.0, 0.6 * kR}) {
+      const std::string dir = make_run_dir("led_collide");
+      const double gap = 1e-5;  // between the surfaces at the start, along x
+      const double cx = std::sqrt(4.0 * kR * kR - b * b);
+      std::vector<Sphere> atoms(2);
+      atoms[0].x = {-0.5 * (cx + gap), -0.5 * b, 0.0};
+      atoms[1].x = {0.5 * (cx + gap), 0.5 * b, 0.0};
+      atoms[0].v = {u, 0.0, 0.0};
+      atoms[1].v = {-u, 0.0, 0.0};
+      std::ostringstream d;
+      d.precision(17);
+      d << ledger_fix(10, "") << "fix integr all nve/sphere\ntimestep 2e-9\nrun 20000\n";
+      for (int a = 1; a <= 2; ++a)
+        d << "variable vx" << a << " equal vx[" << a << "]\nvariable vy" << a << " equal vy[" << a
+          << "]\nvariable wz" << a << " equal omegaz[" << a << "]\n";
+      d << "print \"${vx1} ${vy1} ${vx2} ${vy2} ${wz1} ${wz2}\" file v1.txt\n";
+      const auto r = run_ledger_deck(dir, atoms, d.str(), e);
+      ASSERT_EQ(r.exit_code, 0) << r.screen;
+      const auto vrow = read_table(dir + "/v1.txt");
+      ASSERT_FALSE(vrow.empty());
+      const auto &v = vrow.front();
+      const Ledger l = read_ledger(dir + "/ledger.csv");
+      ASSERT_FALSE(l.rows.empty());
+      // Relative velocity (2 - 1) before and after; the normal at first touch.
+      const double n[2] = {-cx / (2.0 * kR), -b / (2.0 * kR)};
+      const double w0[2] = {-2.0 * u, 0.0}, w1[2] = {v[2] - v[0], v[3] - v[1]};
+      const double vn0 = w0[0] * n[0] + w0[1] * n[1], vn1 = w1[0] * n[0] + w1[1] * n[1];
+      const double lost_total =
+          0.5 * m * (2.0 * u * u - (v[0] * v[0] + v[1] * v[1]) - (v[2] * v[2] + v[3] * v[3])) -
+          0.5 * sphere_inertia(kR) * (v[4] * v[4] + v[5] * v[5]);
+      const double lost_normal = 0.5 * mstar * (vn0 * vn0 - vn1 * vn1);
+      const double damp = l.last("contact_damping_J"), fric = l.last("contact_friction_J");
+      std::printf(
+          "collision, e = %.1f, b = %.1f r: rebound |vn1/vn0| %.6f (vs e, rel. %.2e), lost %.9e J "
+          "(normal %.9e J), contact_damping %.9e J (rel. to normal loss %.3e), contact_friction "
+          "%.4g J, contact_elastic at the end %.3g J, residual %.3g J\n",
+          e, b / kR, std::fabs(vn1 / vn0), std::fabs(vn1 / vn0) / e - 1.0, lost_total, lost_normal,
+          damp, damp / lost_normal - 1.0, fric, l.last("contact_elastic_J"), l.last("residual_J"));
+      EXPECT_EQ(l.last("contact_elastic_J"), 0.0);         // exact: the collision is over
+      EXPECT_NEAR((damp + fric) / lost_total, 1.0, 1e-6);  // the balance (CSV digits, dt^2)
+      if (b == 0.0) {
+        EXPECT_NEAR(std::fabs(vn1 / vn0) / e, 1.0, 1e-3);  // restitution within 0.1 %
+        EXPECT_NEAR(damp / lost_total, 1.0, 1e-5);         // dashpot takes it all
+        EXPECT_LT(std::fabs(fric), 1e-5 * lost_total);     // nothing tangential
+      } else {
+        EXPECT_NEAR(damp / lost_normal, 1.0, 1e-2);  // the normal dashpot's share
+        EXPECT_GT(fric, 1e-2 * lost_total);          // sliding and tangential dashpot took some
+      }
+    }
+  }
+}
+
+// ===========================================================================
+// 6. fix energy/work: one element flies free under gravity (9.81 m/s2 along
+//    -z) and a constant push (addforce 1e-4 N along x). A fix energy/work
+//    after each force fix measures that fix's work: for a constant force F_k
+//    the ledger's exact velocity-Verlet work is F_k . (x1 - x0) less the end
+//    term dt^2/4 F_k . F / m (F the total force; docs/styles/
+//    fix_energy_ledger.md), from the element's positions (1e-9 relative),
+//    and the two add up to work_other_J (1e-9). A fix energy/work before the ledger
+//    is refused by name.
+// ===========================================================================
+TEST(EnergyLedger, WorkPartsMatchConstantForces) {
+  const std::string dir = make_run_dir("led_parts");
+  const double g = 9.81, fx = 1e-4, m = sphere_mass(kR);
+  Sphere s;
+  s.v = {0.5, 0.0, 2.0};
+  std::ostringstream d;
+  d.precision(17);
+  d << ledger_fix(100, "") << "fix grav all gravity " << g << " vector 0 0 -1\n"
+    << "fix wg all energy/work gravity\nfix push all addforce " << fx << " 0 0\n"
+    << "fix wp all energy/work push\nfix integr all nve/sphere\ntimestep 1e-6\n"
+    << "variable x0 equal x[1]\nvariable z0 equal z[1]\nprint \"${x0} ${z0}\" file x0.txt\n"
+    << "run 3000\nvariable x1 equal x[1]\nvariable z1 equal z[1]\n"
+    << "print \"${x1} ${z1}\" file x1.txt\n";
+  const auto r = run_ledger_deck(dir, {s}, d.str());
+  ASSERT_EQ(r.exit_code, 0) << r.screen;
+  const auto p0 = read_table(dir + "/x0.txt"), p1 = read_table(dir + "/x1.txt");
+  ASSERT_FALSE(p0.empty());
+  ASSERT_FALSE(p1.empty());
+  const Ledger l = read_ledger(dir + "/ledger.csv");
+  ASSERT_FALSE(l.rows.empty());
+  ASSERT_TRUE(l.col.count("work_gravity_J") && l.col.count("work_push_J"));
+  const double q = 0.25 * 1e-6 * 1e-6;  // dt^2 / 4
+  const double wg = m * g * (p0.front()[1] - p1.front()[1]) - q * (m * g) * (m * g) / m;
+  const double wp = fx * (p1.front()[0] - p0.front()[0]) - q * fx * fx / m;
+  std::printf(
+      "free flight: work_gravity %.12e J vs m g (z0 - z1) - end term %.12e J (rel. %.2e, tol "
+      "1e-9), work_push %.12e J vs F (x1 - x0) - end term %.12e J (rel. %.2e), their sum vs "
+      "work_other %.12e J\n",
+      l.last("work_gravity_J"), wg, l.last("work_gravity_J") / wg - 1.0, l.last("work_push_J"), wp,
+      l.last("work_push_J") / wp - 1.0, l.last("work_other_J"));
+  EXPECT_NEAR(l.last("work_gravity_J") / wg, 1.0, 1e-9);
+  EXPECT_NEAR(l.last("work_push_J") / wp, 1.0, 1e-9);
+  EXPECT_NEAR((l.last("work_gravity_J") + l.last("work_push_J")) / l.last("work_other_J"), 1.0,
+              1e-9);
+
+  const std::string bad = make_run_dir("led_parts_order");
+  std::ostringstream b;
+  b << "fix wg all energy/work gravity\n"
+    << ledger_fix(100, "") << "fix integr all nve/sphere\ntimestep 1e-6\nrun 10\n";
+  const auto rb = run_ledger_deck(bad, {s}, b.str());
+  const bool names =
+      rb.screen.find("fix energy/work wg is defined before the ledger") != std::string::npos;
+  std::printf("energy/work before the ledger: exit code %d, message names it: %s\n", rb.exit_code,
+              names ? "yes" : "no");
+  EXPECT_NE(rb.exit_code, 0) << rb.screen;
+  EXPECT_TRUE(names) << rb.screen;
 }

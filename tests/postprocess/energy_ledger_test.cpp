@@ -23,8 +23,9 @@ const std::string kComment =
 const std::string kHeader =
     "step,time_s,ke_trans_J,ke_rot_J,numerical_J,bond_elastic_J,bond_released_J,bond_damping_J,"
     "bond_friction_J,wall_elastic_J,wall_damping_J,wall_friction_J,contact_elastic_J,"
-    "contact_dissipated_J,work_other_J,input_J,residual_J,max_speed_m_s,wall_overlap\n";
-const std::string kRow0 = "0,0,12.5,0,0,0,0,0,0,0,0,0,0,0,0,12.5,0,150,0\n";
+    "contact_damping_J,contact_friction_J,work_other_J,input_J,residual_J,max_speed_m_s,wall_"
+    "overlap\n";
+const std::string kRow0 = "0,0,12.5,0,0,0,0,0,0,0,0,0,0,0,0,0,12.5,0,150,0\n";
 
 // A fresh empty directory for one test.
 fs::path TestDir() {
@@ -75,7 +76,7 @@ TEST(EnergyLedger, TheBalanceColumnsAddUp) {
   }
   int held = 0;
   for (const LedgerColumn& c : LedgerColumns()) held += c.role == LedgerRole::kHeld;
-  EXPECT_EQ(held, 12);  // ke_trans .. contact_dissipated
+  EXPECT_EQ(held, 13);  // ke_trans .. contact_friction
 }
 
 // The figures worked out by hand from ledger_small.csv.
@@ -92,13 +93,15 @@ TEST(EnergyLedger, SummaryByHand) {
   EXPECT_DOUBLE_EQ(s.max_speed_time_s, 1e-5);
   EXPECT_DOUBLE_EQ(s.wall_overlap_max, 0.02);
   EXPECT_DOUBLE_EQ(s.comminution_efficiency, 3.0 / 13.0);  // released / (input + work_other)
-  // Every column in J of the last row, in file order: the 12 held terms,
+  // Every column in J of the last row, in file order: the 13 held terms,
   // work_other, input and residual.
-  ASSERT_EQ(s.final_energy.size(), 15u);
+  ASSERT_EQ(s.final_energy.size(), 16u);
   EXPECT_EQ(s.final_energy.front().first, "ke_trans_J");
   EXPECT_DOUBLE_EQ(s.final_energy.front().second, 3.0);
-  EXPECT_EQ(s.final_energy[11].first, "contact_dissipated_J");
-  EXPECT_DOUBLE_EQ(s.final_energy[11].second, 2.9);
+  EXPECT_EQ(s.final_energy[11].first, "contact_damping_J");
+  EXPECT_DOUBLE_EQ(s.final_energy[11].second, 2.5);
+  EXPECT_EQ(s.final_energy[12].first, "contact_friction_J");
+  EXPECT_DOUBLE_EQ(s.final_energy[12].second, 0.4);
   EXPECT_EQ(s.final_energy.back().first, "residual_J");
 }
 
@@ -125,11 +128,11 @@ TEST(EnergyLedger, BadFilesNameTheFileAndLine) {
   };
   std::string m = Message(f, kComment + "step,time_s,ke_trans_J\n" + kRow0);
   EXPECT_TRUE(has(m, name + ":2: header lacks column 'ke_rot_J'")) << m;
-  m = Message(f, kComment + kHeader + kRow0 + "1,1e-6,12.5,0,0,0,0,0,0,0,0,0,0,0,0,12.5,0,150\n");
-  EXPECT_TRUE(has(m, name + ":4: 18 values, the header has 19")) << m;
-  m = Message(f, kComment + kHeader + "0,0,12.5,abc,0,0,0,0,0,0,0,0,0,0,0,12.5,0,150,0\n");
+  m = Message(f, kComment + kHeader + kRow0 + "1,1e-6,12.5,0,0,0,0,0,0,0,0,0,0,0,0,0,12.5,0,150\n");
+  EXPECT_TRUE(has(m, name + ":4: 19 values, the header has 20")) << m;
+  m = Message(f, kComment + kHeader + "0,0,12.5,abc,0,0,0,0,0,0,0,0,0,0,0,0,12.5,0,150,0\n");
   EXPECT_TRUE(has(m, name + ":3: ke_rot_J: expected a finite number, got 'abc'")) << m;
-  m = Message(f, kComment + kHeader + "0,0,12.5,nan,0,0,0,0,0,0,0,0,0,0,0,12.5,0,150,0\n");
+  m = Message(f, kComment + kHeader + "0,0,12.5,nan,0,0,0,0,0,0,0,0,0,0,0,0,12.5,0,150,0\n");
   EXPECT_TRUE(has(m, name + ":3: ke_rot_J: expected a finite number, got 'nan'")) << m;
   m = Message(f, kComment + kHeader);
   EXPECT_TRUE(has(m, name + ": no rows after the header")) << m;
@@ -138,10 +141,10 @@ TEST(EnergyLedger, BadFilesNameTheFileAndLine) {
   m = Message(f, kComment + "step,step," + kHeader.substr(5) + kRow0);
   EXPECT_TRUE(has(m, name + ":2: header names column 'step' twice")) << m;
   // A row whose terms do not add up to input + work_other.
-  m = Message(f, kComment + kHeader + kRow0 + "1,1e-6,11,0,0,0,0,0,0,0,0,0,0,0,0,12.5,0,150,0\n");
+  m = Message(f, kComment + kHeader + kRow0 + "1,1e-6,11,0,0,0,0,0,0,0,0,0,0,0,0,0,12.5,0,150,0\n");
   EXPECT_TRUE(has(m, name + ":4: the balance does not close")) << m;
   // Nothing put in: the efficiency is undefined.
-  m = Message(f, kComment + kHeader + "0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0\n");
+  m = Message(f, kComment + kHeader + "0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0\n");
   EXPECT_TRUE(has(m, name + ":3: input_J + max(work_other_J, 0) is 0 J")) << m;
   try {
     ReadEnergyLedger((f.parent_path() / "absent.csv").string());
@@ -162,7 +165,7 @@ TEST(EnergyLedger, ExtraColumnsAndCommentsAreKept) {
   std::ofstream(f) << kComment << header << "\n# a comment\n"
                    << row.substr(0, row.size() - 1) << "\r\n";
   const EnergyLedger l = ReadEnergyLedger(f.string());
-  ASSERT_EQ(l.columns.size(), 20u);
+  ASSERT_EQ(l.columns.size(), 21u);
   EXPECT_EQ(l.columns.back(), "residual_bonds_J");
   EXPECT_DOUBLE_EQ(l.last("residual_bonds_J"), 0.5);
   EXPECT_EQ(l.lines, std::vector<long>{5});

@@ -10,6 +10,7 @@
 
 #include "engine/liggghts.h"
 #include "progress.h"
+#include "stages/stage_util.h"
 
 namespace mill::calibrate {
 namespace fs = std::filesystem;
@@ -63,7 +64,7 @@ engine::Result LabBench::run_lab_deck(const std::string& deck, const fs::path& w
 }
 
 // Run one lab test with bond parameters p at the given strain rate; read
-// what its deck wrote into `out`.
+// what its deck wrote into `out`: info line, load curve and energy ledger.
 void LabBench::run_test(const Test& test, const BondParams& p, double rate, const RunStep& step,
                         LabRun& out) {
   const config::Document& d = ctx_.cfg.doc;
@@ -80,10 +81,12 @@ void LabBench::run_test(const Test& test, const BondParams& p, double rate, cons
     vars.push_back(kv);
   const fs::path work = dir_ / "runs" / step.tag;
   const engine::Result res = run_lab_deck(test.name + ".in.tmpl", work, vars, step);
+  out.tag = step.tag;
   out.seconds = res.seconds;
   out.info_file = work / (test.name + "_info.txt");
   out.info = read_info(out.info_file);
   out.curve = post::ReadLoadCurve((work / (test.name + "_curve.txt")).string());
+  out.energy = post::SummariseLedger(read_run_ledger(work));
 }
 
 // A UCS test with bond parameters p at the given strain rate.

@@ -1,6 +1,7 @@
 // The virtual lab tests of the calibrate stage: the UCS and Brazilian decks
 // (liggghts_inputs/{ucs,brazilian}.in.tmpl) run on the carved specimens, their
-// curves read and analysed (docs/calibration.md, steps 3 and 4).
+// curves read and analysed, their energy ledgers summarised
+// (docs/calibration.md, steps 3 and 4, and "Energy ledger").
 #pragma once
 
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "engine/runner.h"
+#include "postprocess/energy_ledger.h"
 #include "postprocess/lab_tests.h"
 #include "stages/calibrate/specimen.h"
 #include "stages/material.h"
@@ -22,11 +24,13 @@ struct Targets {
   double E, nu, ucs, tensile;
 };
 
-// What every lab test gives: the deck's info line and load curve.
+// What every lab test gives: the deck's info line, load curve and energy ledger.
 struct LabRun {
+  std::string tag;  // its folder <dir>/runs/<tag> (RunStep::tag)
   std::map<std::string, double> info;
   std::filesystem::path info_file;  // where `info` was read (named in errors)
   post::LoadCurve curve;
+  post::LedgerSummary energy;  // the run's ledger.csv, summarised
   double seconds = 0;
   bool peaked = true;  // false: the run reached its strain cap still loading
 };

@@ -12,6 +12,7 @@
 #include "engine/runner.h"
 #include "jobs/job_store.h"
 #include "progress.h"
+#include "stages/calibrate/energy_report.h"
 
 namespace mill::calibrate {
 namespace fs = std::filesystem;
@@ -78,6 +79,7 @@ class Report {
         tol_(fit.tolerance()),
         rate_(cfg.doc.real("calibrate.strain_rate")),
         n_(cfg.doc.integer("calibrate.n_elements")),
+        o_(o),
         sp_(o.specimen),
         hist_(o.hist),
         best_(o.best),
@@ -108,6 +110,7 @@ class Report {
   const Targets t_;
   const double tol_, rate_;
   const long n_;
+  const Outcome& o_;
   const Specimen& sp_;
   const std::vector<Iteration>& hist_;
   const size_t best_;
@@ -176,27 +179,31 @@ std::vector<std::string> Report::explain_missed() const {
   return missed;
 }
 
-// report.json: targets, achieved values, every iteration, specimen, rate check.
+// report.json: targets, achieved values, every iteration, specimen, rate
+// check, the lab runs' energy ledgers.
 nlohmann::json Report::json() const {
   nlohmann::json iters = nlohmann::json::array();
   for (size_t i = 0; i < hist_.size(); ++i) {
     const auto& it = hist_[i];
-    iters.push_back({{"iteration", i + 1},
-                     {"bond", bond_json(it.p)},
-                     {"achieved", macro(it)},
-                     {"errors",
-                      {{"youngs_modulus", it.err_E},
-                       {"poisson_ratio", it.err_nu},
-                       {"ucs", it.err_ucs},
-                       {"tensile_strength", it.err_t}}},
-                     {"within_tolerance", it.converged},
-                     {"ucs_fit_window_Pa", {it.ucs.r.fit_stress_lo, it.ucs.r.fit_stress_hi}},
-                     {"ucs_fit_r2", it.ucs.r.fit.r2},
-                     {"strain_at_peak", it.ucs.r.strain_at_peak},
-                     {"brazilian_peak_force_N", it.br.r.peak_force},
-                     {"ucs_peaked", it.ucs.peaked},
-                     {"brazilian_peaked", it.br.peaked},
-                     {"wall_seconds", it.ucs.seconds + it.br.seconds}});
+    iters.push_back(
+        {{"iteration", i + 1},
+         {"bond", bond_json(it.p)},
+         {"achieved", macro(it)},
+         {"errors",
+          {{"youngs_modulus", it.err_E},
+           {"poisson_ratio", it.err_nu},
+           {"ucs", it.err_ucs},
+           {"tensile_strength", it.err_t}}},
+         {"within_tolerance", it.converged},
+         {"ucs_fit_window_Pa", {it.ucs.r.fit_stress_lo, it.ucs.r.fit_stress_hi}},
+         {"ucs_fit_r2", it.ucs.r.fit.r2},
+         {"strain_at_peak", it.ucs.r.strain_at_peak},
+         {"brazilian_peak_force_N", it.br.r.peak_force},
+         {"ucs_peaked", it.ucs.peaked},
+         {"brazilian_peaked", it.br.peaked},
+         {"energy",
+          {{"ucs", lab_energy_json(it.ucs.energy)}, {"brazilian", lab_energy_json(it.br.energy)}}},
+         {"wall_seconds", it.ucs.seconds + it.br.seconds}});
   }
   nlohmann::json specimen = {{"seed", d_.integer("calibrate.seed")},
                              {"ball_elements", sp_.ball_elements},
@@ -245,8 +252,10 @@ nlohmann::json Report::json() const {
                                              post::RelativeError(half_->r.youngs_modulus,
                                                                  b_.ucs.r.youngs_modulus)},
                                             {"below_5_percent", rate_ok_},
+                                            {"energy", lab_energy_json(half_->energy)},
                                             {"wall_seconds", half_->seconds}}
                            : nlohmann::json(nullptr)},
+      {"energy", energy_summary_json(o_)},
       {"not_reached", missed_},
       {"notes", notes_},
       {"wall_seconds", wall_}};
@@ -286,7 +295,7 @@ std::string Report::yaml() const {
   return y.c_str();
 }
 
-// Markdown report: targets against achieved values.
+// Markdown report: targets against achieved values, then the details.
 std::string Report::markdown() const {
   std::ostringstream md;
   md << fmt::format("# Calibration of {} ({} elements per specimen)\n\n", ore_.str("name"), n_);
@@ -320,8 +329,8 @@ std::string Report::markdown() const {
   for (size_t i = 0; i < hist_.size(); ++i) {
     const auto& it = hist_[i];
     md << fmt::format(
-        "| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.0f} | {:g} | {:.2f} | {:.3f} | {:.2f} | {:.2f} "
-        "| {:.2f} | {:.0f} |\n",
+        "| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.0f} | {:g} | {:.2f} | {:.3f} | {:.2f} | "
+        "{:.2f} | {:.2f} | {:.0f} |\n",
         i + 1, it.p.modulus / 1e9, it.p.stiffness_ratio, it.p.tensile / 1e6, it.p.cohesion / 1e6,
         it.p.friction_angle_deg, it.p.moment_factor, it.ucs.r.youngs_modulus / 1e9,
         it.ucs.r.poisson_ratio, it.ucs.r.ucs / 1e6, it.br.r.tensile_strength / 1e6,
@@ -335,6 +344,7 @@ std::string Report::markdown() const {
         rate_ok_ ? "below 5%: quasi-static" : "5% or more: lower calibrate.strain_rate");
   else
     md << "\n## Loading rate\n\nNot checked (calibrate.rate_check: false).\n";
+  md << energy_markdown(o_);
   md << fmt::format(
       "\n## Specimens\n\nCarved from a ball of {} elements (seed {}), mean element radius {:.3f} "
       "mm (as the "
