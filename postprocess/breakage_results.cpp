@@ -15,6 +15,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "postprocess/h5_util.h"
 #include "postprocess/jk_fit.h"
 #include "postprocess/lammps_dump.h"
 
@@ -159,117 +160,50 @@ void WriteTextAtomically(const std::string& path, const std::string& text) {
 
 namespace {
 
-// Owns an HDF5 id and closes it with the matching H5*close.
-class H5Id {
- public:
-  H5Id(hid_t id, herr_t (*close)(hid_t), const std::string& what) : id_(id), close_(close) {
-    if (id_ < 0) throw PostError(fmt::format("HDF5: {} failed", what));
-  }
-  H5Id(const H5Id&) = delete;
-  H5Id& operator=(const H5Id&) = delete;
-  ~H5Id() {
-    if (id_ >= 0) close_(id_);
-  }
-  operator hid_t() const { return id_; }
-
- private:
-  hid_t id_;
-  herr_t (*close_)(hid_t);
-};
-
-// Silences HDF5's own error printing for the scope; errors become PostError.
-class H5Quiet {
- public:
-  H5Quiet() {
-    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~H5Quiet() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
-
- private:
-  H5E_auto2_t func_ = nullptr;
-  void* data_ = nullptr;
-};
-
-// Throws with `what` if an HDF5 call returned a negative status.
-void H5Check(herr_t status, const std::string& what) {
-  if (status < 0) throw PostError(fmt::format("HDF5: {} failed", what));
-}
-
-// Attaches a scalar string attribute to an object.
-void WriteStringAttr(hid_t obj, const char* name, const std::string& value) {
-  H5Id type(H5Tcopy(H5T_C_S1), H5Tclose, "string type");
-  H5Check(H5Tset_size(type, std::max<std::size_t>(1, value.size())), "string size");
-  H5Check(H5Tset_strpad(type, H5T_STR_NULLTERM), "string pad");
-  H5Id space(H5Screate(H5S_SCALAR), H5Sclose, "scalar space");
-  H5Id attr(H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
-            fmt::format("attribute {}", name));
-  const std::string padded = value.empty() ? std::string(1, '\0') : value;
-  H5Check(H5Awrite(attr, type, padded.data()), fmt::format("writing attribute {}", name));
-}
-
-// Attaches a scalar numeric attribute (double or int64) to an object.
+// Attaches a scalar numeric attribute: int64 when `integer`, else double.
 void WriteNumberAttr(hid_t obj, const char* name, double value, bool integer) {
-  H5Id space(H5Screate(H5S_SCALAR), H5Sclose, "scalar space");
-  const hid_t file_type = integer ? H5T_STD_I64LE : H5T_IEEE_F64LE;
-  H5Id attr(H5Acreate2(obj, name, file_type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
-            fmt::format("attribute {}", name));
   if (integer) {
     const long long v = std::llround(value);
-    H5Check(H5Awrite(attr, H5T_NATIVE_LLONG, &v), fmt::format("writing attribute {}", name));
+    h5::WriteAttr(obj, name, H5T_STD_I64LE, H5T_NATIVE_LLONG, &v);
   } else {
-    H5Check(H5Awrite(attr, H5T_NATIVE_DOUBLE, &value), fmt::format("writing attribute {}", name));
+    h5::WriteAttr(obj, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
   }
 }
 
 // Reads a scalar numeric attribute as double.
-double ReadNumberAttr(hid_t obj, const char* name, const std::string& where) {
+double ReadNumberAttr(hid_t obj, const char* name) {
   if (H5Aexists(obj, name) <= 0) {
-    throw PostError(fmt::format("{}: attribute '{}' is missing", where, name));
+    throw PostError(fmt::format("{}: attribute '{}' is missing", h5::Where(obj), name));
   }
-  H5Id attr(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose, fmt::format("{} attribute {}", where, name));
+  h5::Handle attr(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose, obj,
+                  fmt::format("open attribute '{}'", name));
   double v = 0.0;
-  H5Check(H5Aread(attr, H5T_NATIVE_DOUBLE, &v), fmt::format("{}: reading {}", where, name));
+  h5::Check(H5Aread(attr, H5T_NATIVE_DOUBLE, &v), obj, fmt::format("read attribute '{}'", name));
   return v;
 }
 
-// Writes a 1-D or 2-D dataset of doubles or int64 with its `unit` attribute.
-template <typename T>
-void WriteDataset(hid_t loc, const char* name, const std::vector<T>& data,
-                  std::vector<hsize_t> dims, const char* unit) {
-  static_assert(std::is_same_v<T, double> || std::is_same_v<T, long long>);
-  const bool is_int = std::is_same_v<T, long long>;
-  H5Id space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose,
-             fmt::format("dataspace of {}", name));
-  H5Id set(H5Dcreate2(loc, name, is_int ? H5T_STD_I64LE : H5T_IEEE_F64LE, space, H5P_DEFAULT,
-                      H5P_DEFAULT, H5P_DEFAULT),
-           H5Dclose, fmt::format("dataset {}", name));
-  if (!data.empty()) {
-    H5Check(H5Dwrite(set, is_int ? H5T_NATIVE_LLONG : H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL,
-                     H5P_DEFAULT, data.data()),
-            fmt::format("writing {}", name));
+// Creates the group `name` of a file, replacing one already there.
+h5::Handle ReplaceGroup(hid_t file, const char* name) {
+  if (H5Lexists(file, name, H5P_DEFAULT) > 0) {
+    h5::Check(H5Ldelete(file, name, H5P_DEFAULT), file,
+              fmt::format("delete the old group '{}'", name));
   }
-  WriteStringAttr(set, "unit", unit);
-}
-
-// Creates an HDF5 group.
-hid_t MakeGroup(hid_t loc, const std::string& name) {
-  return H5Gcreate2(loc, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  return h5::CreateGroup(file, name);
 }
 
 // Writes the /summary/<column> datasets for a list of summaries.
 void WriteSummaryGroup(hid_t file, const std::vector<ImpactSummary>& rows) {
-  H5Id group(MakeGroup(file, "summary"), H5Gclose, "group /summary");
+  const h5::Handle group = h5::CreateGroup(file, "summary");
   const std::vector<hsize_t> dims = {rows.size()};
   for (const Column& c : Columns()) {
     if (c.integer) {
       std::vector<long long> v;
       for (const auto& r : rows) v.push_back(std::llround(c.get(r)));
-      WriteDataset(group, c.name, v, dims, c.unit);
+      h5::WriteDataset(group, c.name, v, dims, c.unit);
     } else {
       std::vector<double> v;
       for (const auto& r : rows) v.push_back(c.get(r));
-      WriteDataset(group, c.name, v, dims, c.unit);
+      h5::WriteDataset(group, c.name, v, dims, c.unit);
     }
   }
 }
@@ -278,7 +212,7 @@ void WriteSummaryGroup(hid_t file, const std::vector<ImpactSummary>& rows) {
 void WriteImpactGroup(hid_t impacts, const ImpactResult& r) {
   const std::string name =
       ImpactGroupName({r.summary.velocity_m_s, r.summary.angle_deg, r.summary.repeat});
-  H5Id g(MakeGroup(impacts, name), H5Gclose, fmt::format("group /impacts/{}", name));
+  const h5::Handle g = h5::CreateGroup(impacts, name);
   const hsize_t n = r.fragments.size();
   std::vector<long long> count;
   std::vector<double> mass, diameter, d_rel, velocity;
@@ -290,42 +224,42 @@ void WriteImpactGroup(hid_t impacts, const ImpactResult& r) {
     d_rel.push_back(f.diameter / d_ref);
     velocity.insert(velocity.end(), f.velocity.begin(), f.velocity.end());
   }
-  WriteDataset(g, "n_elements", count, {n}, "1");
-  WriteDataset(g, "mass", mass, {n}, "kg");
-  WriteDataset(g, "diameter", diameter, {n}, "m");
-  WriteDataset(g, "d_rel", d_rel, {n}, "1");
-  WriteDataset(g, "velocity", velocity, {n, 3}, "m/s");
-  WriteDataset(g, "fraction_edges", r.fraction_edges, {r.fraction_edges.size()}, "1");
-  WriteDataset(g, "fraction_mass", r.fraction_mass, {r.fraction_mass.size()}, "1");
+  h5::WriteDataset(g, "n_elements", count, {n}, "1");
+  h5::WriteDataset(g, "mass", mass, {n}, "kg");
+  h5::WriteDataset(g, "diameter", diameter, {n}, "m");
+  h5::WriteDataset(g, "d_rel", d_rel, {n}, "1");
+  h5::WriteDataset(g, "velocity", velocity, {n, 3}, "m/s");
+  h5::WriteDataset(g, "fraction_edges", r.fraction_edges, {r.fraction_edges.size()}, "1");
+  h5::WriteDataset(g, "fraction_mass", r.fraction_mass, {r.fraction_mass.size()}, "1");
   for (const Column& c : Columns()) WriteNumberAttr(g, c.name, c.get(r.summary), c.integer);
   std::string warnings;
   for (const auto& w : r.warnings) warnings += (warnings.empty() ? "" : "\n") + w;
-  WriteStringAttr(g, "warnings", warnings);
-  WriteStringAttr(g, "diameter_definition",
-                  "equal-volume sphere of the solid: d = (6 m / (pi rho))^(1/3)");
+  h5::WriteStringAttr(g, "warnings", warnings);
+  h5::WriteStringAttr(g, "diameter_definition",
+                      "equal-volume sphere of the solid: d = (6 m / (pi rho))^(1/3)");
 }
 
 // An impact group's summary attributes. Columns past the required ones may be
 // missing (a file from before they existed): they keep the field's default.
-ImpactSummary ReadSummaryAttrs(hid_t g, const std::string& where) {
+ImpactSummary ReadSummaryAttrs(hid_t g) {
   ImpactSummary s;
   const auto& cols = Columns();
   for (std::size_t c = 0; c < cols.size(); ++c) {
     if (c >= kRequiredColumns && H5Aexists(g, cols[c].name) <= 0) continue;
-    cols[c].set(s, ReadNumberAttr(g, cols[c].name, where));
+    cols[c].set(s, ReadNumberAttr(g, cols[c].name));
   }
   return s;
 }
 
 // The names of the links in a group, in name order.
-std::vector<std::string> LinkNames(hid_t group, const std::string& where) {
+std::vector<std::string> LinkNames(hid_t group) {
   H5G_info_t info;
-  H5Check(H5Gget_info(group, &info), fmt::format("{}: group info", where));
+  h5::Check(H5Gget_info(group, &info), group, "list the group");
   std::vector<std::string> names;
   for (hsize_t k = 0; k < info.nlinks; ++k) {
     const ssize_t len =
         H5Lget_name_by_idx(group, ".", H5_INDEX_NAME, H5_ITER_INC, k, nullptr, 0, H5P_DEFAULT);
-    if (len < 0) throw PostError(fmt::format("{}: cannot list", where));
+    if (len < 0) h5::Fail(h5::Where(group), "list the group");
     std::string name(static_cast<std::size_t>(len) + 1, '\0');
     H5Lget_name_by_idx(group, ".", H5_INDEX_NAME, H5_ITER_INC, k, name.data(), name.size(),
                        H5P_DEFAULT);
@@ -346,15 +280,8 @@ void CopyEnergyGroup(hid_t in, const std::string& in_path, const std::vector<std
         in_path, names.size()));
   }
   const std::string to = names[0] + "/energy";
-  H5Check(H5Ocopy(in, "energy", out_impacts, to.c_str(), H5P_DEFAULT, H5P_DEFAULT),
-          fmt::format("copying /energy from {} to /impacts/{}", in_path, to));
-}
-
-// Creates (or truncates) an HDF5 file for writing.
-hid_t CreateTmpFile(const std::string& tmp) {
-  const hid_t file = H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-  if (file < 0) throw PostError(fmt::format("{}: cannot create HDF5 file", tmp));
-  return file;
+  h5::Check(H5Ocopy(in, "energy", out_impacts, to.c_str(), H5P_DEFAULT, H5P_DEFAULT), out_impacts,
+            fmt::format("copy /energy of {} to '{}'", in_path, to));
 }
 
 }  // namespace
@@ -618,8 +545,6 @@ std::vector<ImpactSummary> ReadSummaryCsv(const std::string& path) {
 
 // breakage.h5 from in-memory results.
 void WriteBreakageH5(const std::string& path, const std::vector<ImpactResult>& results) {
-  H5Quiet quiet;
-  const std::string tmp = path + ".tmp";
   std::set<std::string> names;
   for (const auto& r : results) {
     const std::string n =
@@ -628,97 +553,78 @@ void WriteBreakageH5(const std::string& path, const std::vector<ImpactResult>& r
       throw PostError(fmt::format("{}: impact {} appears twice in the results", path, n));
     }
   }
-  try {
-    H5Id file(CreateTmpFile(tmp), H5Fclose, "create");
-    WriteStringAttr(file, "format", kFormat);
-    H5Id impacts(MakeGroup(file, "impacts"), H5Gclose, "group /impacts");
+  h5::WriteFileAtomically(path, path + ".tmp", [&](hid_t file) {
+    h5::WriteStringAttr(file, "format", kFormat);
+    const h5::Handle impacts = h5::CreateGroup(file, "impacts");
     std::vector<ImpactSummary> rows;
     for (const auto& r : results) {
       WriteImpactGroup(impacts, r);
       rows.push_back(r.summary);
     }
     WriteSummaryGroup(file, rows);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw;
-  }
-  fs::rename(tmp, path);
+  });
 }
 
 // breakage.h5 merged from per-impact files.
 void MergeBreakageH5Files(const std::string& path, const std::vector<std::string>& inputs) {
-  H5Quiet quiet;
-  const std::string tmp = path + ".tmp";
-  try {
-    H5Id out(CreateTmpFile(tmp), H5Fclose, "create");
-    WriteStringAttr(out, "format", kFormat);
-    H5Id out_impacts(MakeGroup(out, "impacts"), H5Gclose, "group /impacts");
+  h5::WriteFileAtomically(path, path + ".tmp", [&](hid_t out) {
+    h5::WriteStringAttr(out, "format", kFormat);
+    const h5::Handle out_impacts = h5::CreateGroup(out, "impacts");
     std::map<std::string, std::string> source_of;
     std::vector<ImpactSummary> rows;
     for (const std::string& in_path : inputs) {
-      const hid_t raw = H5Fopen(in_path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-      if (raw < 0) throw PostError(fmt::format("{}: cannot open as HDF5", in_path));
-      H5Id in(raw, H5Fclose, "open");
+      const h5::Handle in = h5::OpenFile(in_path, H5F_ACC_RDONLY);
       if (H5Lexists(in, "impacts", H5P_DEFAULT) <= 0) {
         throw PostError(fmt::format("{}: no /impacts group (not a breakage.h5?)", in_path));
       }
-      H5Id in_impacts(H5Gopen2(in, "impacts", H5P_DEFAULT), H5Gclose, "open /impacts");
-      const std::vector<std::string> names =
-          LinkNames(in_impacts, fmt::format("{}:/impacts", in_path));
+      const h5::Handle in_impacts(H5Gopen2(in, "impacts", H5P_DEFAULT), H5Gclose, in,
+                                  "open group 'impacts'");
+      const std::vector<std::string> names = LinkNames(in_impacts);
       for (const std::string& name : names) {
         auto [it, fresh] = source_of.emplace(name, in_path);
         if (!fresh) {
           throw PostError(fmt::format("impact {} is in both {} and {}", name, it->second, in_path));
         }
-        H5Check(
+        h5::Check(
             H5Ocopy(in_impacts, name.c_str(), out_impacts, name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
-            fmt::format("copying /impacts/{} from {}", name, in_path));
-        H5Id g(H5Gopen2(in_impacts, name.c_str(), H5P_DEFAULT), H5Gclose, "open impact");
-        rows.push_back(ReadSummaryAttrs(g, fmt::format("{}:/impacts/{}", in_path, name)));
+            out_impacts, fmt::format("copy /impacts/{} of {}", name, in_path));
+        const h5::Handle g(H5Gopen2(in_impacts, name.c_str(), H5P_DEFAULT), H5Gclose, in_impacts,
+                           fmt::format("open group '{}'", name));
+        rows.push_back(ReadSummaryAttrs(g));
       }
       // The ledger is copied per impact, not skipped: breakage.h5 holds every
       // impact's time series under its own group.
       CopyEnergyGroup(in, in_path, names, out_impacts);
     }
     WriteSummaryGroup(out, rows);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw;
-  }
-  fs::rename(tmp, path);
+  });
 }
 
 // The JK fits as /jk_fit/<name> groups of an existing file.
 void WriteJkFitH5(const std::string& path, const std::vector<JkFitRecord>& records) {
-  H5Quiet quiet;
-  const hid_t raw = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-  if (raw < 0) throw PostError(fmt::format("{}: cannot open as HDF5 for writing", path));
-  H5Id file(raw, H5Fclose, "open");
-  if (H5Lexists(file, "jk_fit", H5P_DEFAULT) > 0)
-    H5Check(H5Ldelete(file, "jk_fit", H5P_DEFAULT), "delete /jk_fit");
-  H5Id top(MakeGroup(file, "jk_fit"), H5Gclose, "group /jk_fit");
-  WriteStringAttr(top, "relation",
-                  "t10 = A (1 - exp(-b Ecs)), Ecs = V^2/2 in kWh/t (Napier-Munn et al. 1996, "
-                  "Mineral Comminution Circuits, JKMRC)");
+  const h5::Quiet quiet;
+  const h5::Handle file = h5::OpenFile(path, H5F_ACC_RDWR);
+  const h5::Handle top = ReplaceGroup(file, "jk_fit");
+  h5::WriteStringAttr(top, "relation",
+                      "t10 = A (1 - exp(-b Ecs)), Ecs = V^2/2 in kWh/t (Napier-Munn et al. 1996, "
+                      "Mineral Comminution Circuits, JKMRC)");
   for (const JkFitRecord& r : records) {
     const std::size_t n = r.ecs_kwh_t.size();
     if (r.t10_percent.size() != n || r.repeat.size() != n || r.used.size() != n) {
       throw PostError(fmt::format("{}: /jk_fit/{}: point arrays differ in length", path, r.name));
     }
-    H5Id g(MakeGroup(top, r.name), H5Gclose, fmt::format("group /jk_fit/{}", r.name));
-    WriteDataset(g, "ecs", r.ecs_kwh_t, {n}, "kWh/t");
-    WriteDataset(g, "t10", r.t10_percent, {n}, "%");
-    WriteDataset(g, "repeat", r.repeat, {n}, "1");
-    WriteDataset(g, "used", r.used, {n}, "1");
+    const h5::Handle g = h5::CreateGroup(top, r.name);
+    h5::WriteDataset(g, "ecs", r.ecs_kwh_t, {n}, "kWh/t");
+    h5::WriteDataset(g, "t10", r.t10_percent, {n}, "%");
+    h5::WriteDataset(g, "repeat", r.repeat, {n}, "1");
+    h5::WriteDataset(g, "used", r.used, {n}, "1");
     const JkFit& f = r.fit.pooled;
-    WriteStringAttr(
+    h5::WriteStringAttr(
         g, "status",
         f.ok ? (f.note.empty() ? "fitted" : "fitted: " + f.note) : "not fitted: " + f.reason);
     if (!f.ok) continue;
     auto scalar = [&](const char* name, double v, const char* unit) {
-      WriteDataset(g, name, std::vector<double>{v}, {1}, unit);
+      h5::WriteDataset(g, name, std::vector<double>{v}, {1}, unit);
     };
     scalar("A", f.a_percent, "%");
     scalar("b", f.b_t_per_kwh, "t/kWh");
@@ -739,28 +645,25 @@ void WriteJkFitH5(const std::string& path, const std::vector<JkFitRecord>& recor
 
 // The ledger's columns as /energy of an existing file.
 void WriteEnergyLedgerH5(const std::string& path, const EnergyLedger& ledger) {
-  H5Quiet quiet;
-  const hid_t raw = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-  if (raw < 0) throw PostError(fmt::format("{}: cannot open as HDF5 for writing", path));
-  H5Id file(raw, H5Fclose, "open");
-  if (H5Lexists(file, "energy", H5P_DEFAULT) > 0)
-    H5Check(H5Ldelete(file, "energy", H5P_DEFAULT), "delete /energy");
-  H5Id g(MakeGroup(file, "energy"), H5Gclose, "group /energy");
-  WriteStringAttr(g, "balance",
-                  "input + work_other = ke_trans + ke_rot + numerical + bond_elastic + "
-                  "bond_released + bond_damping + bond_friction + wall_elastic + wall_damping + "
-                  "wall_friction + contact_elastic + contact_dissipated + residual "
-                  "(docs/styles/fix_energy_ledger.md)");
-  WriteStringAttr(g, "source", ledger.path);
+  const h5::Quiet quiet;
+  const h5::Handle file = h5::OpenFile(path, H5F_ACC_RDWR);
+  const h5::Handle g = ReplaceGroup(file, "energy");
+  h5::WriteStringAttr(
+      g, "balance",
+      "input + work_other = ke_trans + ke_rot + numerical + bond_elastic + "
+      "bond_released + bond_damping + bond_friction + wall_elastic + wall_damping + "
+      "wall_friction + contact_elastic + contact_damping + contact_friction + residual "
+      "(docs/styles/fix_energy_ledger.md)");
+  h5::WriteStringAttr(g, "source", ledger.path);
   const std::vector<hsize_t> dims = {ledger.rows()};
   for (std::size_t c = 0; c < ledger.columns.size(); ++c) {
     const std::string& name = ledger.columns[c];
     if (name == "step") {
       std::vector<long long> steps;
       for (double v : ledger.values[c]) steps.push_back(std::llround(v));
-      WriteDataset(g, name.c_str(), steps, dims, "1");
+      h5::WriteDataset(g, name, steps, dims, "1");
     } else {
-      WriteDataset(g, name.c_str(), ledger.values[c], dims, LedgerUnit(name).c_str());
+      h5::WriteDataset(g, name, ledger.values[c], dims, LedgerUnit(name));
     }
   }
 }

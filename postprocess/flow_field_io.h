@@ -49,12 +49,12 @@ struct FlowField {
 };
 
 // Write the field to `file` (via a temp file renamed at the end). Throws
-// std::runtime_error naming the file on failure, std::invalid_argument when
-// array sizes do not match dims.
+// PostError (a std::runtime_error, fragments.h) naming the file on failure,
+// std::invalid_argument when array sizes do not match dims.
 void write_flow_field(const std::filesystem::path& file, const FlowField& f);
 
-// Read a field written by write_flow_field. Throws std::runtime_error naming
-// the file and the missing/bad item.
+// Read a field written by write_flow_field. Throws PostError naming the file
+// and the missing/bad item.
 FlowField read_flow_field(const std::filesystem::path& file);
 
 // Unit attribute of a dataset ("m/s" for "U"); "" if absent. For tests/tools.

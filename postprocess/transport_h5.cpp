@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <filesystem>
 #include <functional>
 #include <iterator>
 #include <limits>
@@ -19,80 +18,32 @@
 #include <vector>
 
 #include "postprocess/fragments.h"
+#include "postprocess/h5_util.h"
 
 namespace mill::post {
-namespace fs = std::filesystem;
 
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Owns an HDF5 id and closes it with the matching close function.
-class H5Handle {
- public:
-  H5Handle(hid_t id, herr_t (*close)(hid_t), const std::string& what) : id_(id), close_(close) {
-    if (id_ < 0) throw PostError("HDF5: cannot " + what);
-  }
-  H5Handle(const H5Handle&) = delete;
-  H5Handle& operator=(const H5Handle&) = delete;
-  ~H5Handle() {
-    if (id_ >= 0) close_(id_);
-  }
-  operator hid_t() const { return id_; }
-
- private:
-  hid_t id_;
-  herr_t (*close_)(hid_t);
-};
-
-// Creates the group /name of the file.
-H5Handle group(hid_t file, const std::string& name) {
-  return {H5Gcreate2(file, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
-          "create /" + name};
-}
-
-// Attaches a string attribute.
-void attr_string(hid_t obj, const std::string& name, const std::string& value) {
-  H5Handle type(H5Tcopy(H5T_C_S1), H5Tclose, "copy string type");
-  H5Tset_size(type, std::max<size_t>(1, value.size()));
-  H5Tset_strpad(type, H5T_STR_NULLTERM);
-  H5Handle space(H5Screate(H5S_SCALAR), H5Sclose, "create scalar space");
-  H5Handle a(H5Acreate2(obj, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
-             "create attribute " + name);
-  std::string padded = value.empty() ? std::string(1, '\0') : value;
-  if (H5Awrite(a, type, padded.data()) < 0) throw PostError("HDF5: cannot write attribute " + name);
-}
-
 // Attaches a scalar double attribute.
 void attr_double(hid_t obj, const std::string& name, double value) {
-  H5Handle space(H5Screate(H5S_SCALAR), H5Sclose, "create scalar space");
-  H5Handle a(H5Acreate2(obj, name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT),
-             H5Aclose, "create attribute " + name);
-  if (H5Awrite(a, H5T_NATIVE_DOUBLE, &value) < 0)
-    throw PostError("HDF5: cannot write attribute " + name);
+  h5::WriteAttr(obj, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
 }
 
-// Writes a dataset of n rows x cols values (cols 1: a vector) with a unit.
-template <typename T>
-void dataset(hid_t group, const std::string& name, const std::vector<T>& v, int cols,
-             const std::string& unit, hid_t file_type, hid_t mem_type) {
-  hsize_t dims[2] = {static_cast<hsize_t>(v.size() / cols), static_cast<hsize_t>(cols)};
-  H5Handle space(H5Screate_simple(cols == 1 ? 1 : 2, dims, nullptr), H5Sclose,
-                 "create space for " + name);
-  H5Handle d(
-      H5Dcreate2(group, name.c_str(), file_type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-      H5Dclose, "create dataset " + name);
-  if (!v.empty() && H5Dwrite(d, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
-    throw PostError("HDF5: cannot write dataset " + name);
-  attr_string(d, "unit", unit);
-}
+// Writes a float64 dataset of n rows x cols values (cols 1: a vector) with a unit.
 void doubles(hid_t g, const std::string& name, const std::vector<double>& v, int cols,
              const std::string& unit) {
-  dataset(g, name, v, cols, unit, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE);
+  const hsize_t rows = v.size() / static_cast<size_t>(cols);
+  std::vector<hsize_t> dims = {rows};
+  if (cols != 1) dims.push_back(static_cast<hsize_t>(cols));
+  h5::WriteDataset(g, name, v, dims, unit);
 }
+
+// Writes an int64 vector dataset with a unit.
 void integers(hid_t g, const std::string& name, const std::vector<long long>& v,
               const std::string& unit) {
-  dataset(g, name, v, 1, unit, H5T_STD_I64LE, H5T_NATIVE_LLONG);
+  h5::WriteDataset(g, name, v, {v.size()}, unit);
 }
 
 // Flattens a list of 3-vectors.
@@ -132,7 +83,7 @@ struct Column {
 template <typename Row>
 void write_table(hid_t g, const std::vector<Row>& rows, const std::vector<Column<Row>>& columns) {
   for (const auto& c : columns)
-    if (!c.codes.empty()) attr_string(g, c.name + "_codes", c.codes);
+    if (!c.codes.empty()) h5::WriteStringAttr(g, c.name + "_codes", c.codes);
   for (const auto& c : columns) {
     if (c.integer) {
       std::vector<long long> v;
@@ -258,28 +209,27 @@ void WriteTransportH5(const std::string& path, const std::vector<ImpactRecord>& 
                       const Trajectories& traj, const TransportMeta& meta,
                       const std::vector<ContactEnd>& ends) {
   const std::string tmp = path + ".tmp." + std::to_string(getpid());
-  {
-    H5Handle f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose,
-               "create " + tmp);
-    attr_string(
+  h5::WriteFileAtomically(path, tmp, [&](hid_t f) {
+    h5::WriteStringAttr(
         f, "content",
         "transport stage: impacts on flywheel and housing, per-particle counts, trajectories");
     for (const auto& [k, v] : meta.scalars) {
       attr_double(f, k, v);
       const auto u = meta.units.find(k);
-      if (u != meta.units.end() && !u->second.empty()) attr_string(f, k + "_unit", u->second);
+      if (u != meta.units.end() && !u->second.empty())
+        h5::WriteStringAttr(f, k + "_unit", u->second);
     }
-    write_table(group(f, "impacts"), records, impact_columns());
-    write_table(group(f, "contact_ends"), ends, contact_end_columns());
+    write_table(h5::CreateGroup(f, "impacts"), records, impact_columns());
+    write_table(h5::CreateGroup(f, "contact_ends"), ends, contact_end_columns());
     {
-      H5Handle g = group(f, "strikes");
-      attr_string(g, "content",
-                  "one row per beater strike (flywheel impact, not sliding); NaN where the "
-                  "strike has no contact end or no following housing impact");
+      const h5::Handle g = h5::CreateGroup(f, "strikes");
+      h5::WriteStringAttr(g, "content",
+                          "one row per beater strike (flywheel impact, not sliding); NaN where the "
+                          "strike has no contact end or no following housing impact");
       write_table(g, stats.chains, strike_columns(records, ends));
     }
     {
-      H5Handle g = group(f, "particles");
+      const h5::Handle g = h5::CreateGroup(f, "particles");
       integers(g, "id", stats.ids, "1");
       doubles(g, "insert_time", insert_time_s, 1, "s");
       integers(g, "n_impacts", stats.impacts_per_particle, "1");
@@ -287,7 +237,7 @@ void WriteTransportH5(const std::string& path, const std::vector<ImpactRecord>& 
       doubles(g, "first_impact_time", stats.first_impact_time_s, 1, "s");
     }
     {
-      H5Handle g = group(f, "trajectories");
+      const h5::Handle g = h5::CreateGroup(f, "trajectories");
       std::vector<double> speed;
       for (const auto& v : traj.velocity)
         speed.push_back(std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
@@ -297,13 +247,10 @@ void WriteTransportH5(const std::string& path, const std::vector<ImpactRecord>& 
       doubles(g, "velocity", flat3(traj.velocity), 3, "m/s");
       doubles(g, "speed", speed, 1, "m/s");
     }
-    {
-      H5Handle g = group(f, "geometry");
-      attr_string(g, "length_unit", "m");
-      for (const auto& [k, v] : meta.geometry) attr_double(g, k, v);
-    }
-  }
-  fs::rename(tmp, path);
+    const h5::Handle g = h5::CreateGroup(f, "geometry");
+    h5::WriteStringAttr(g, "length_unit", "m");
+    for (const auto& [k, v] : meta.geometry) attr_double(g, k, v);
+  });
 }
 
 }  // namespace mill::post

@@ -9,21 +9,13 @@
 #include <fstream>
 #include <numeric>
 
+#include "test_dir.h"
+
 namespace mill::post {
 namespace {
 
 namespace fs = std::filesystem;
 constexpr double kRho = 2580.0;
-
-// A fresh empty directory for one test.
-fs::path TestDir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir = fs::temp_directory_path() /
-                       (std::string("mill_post_") + info->test_suite_name() + "_" + info->name());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
 
 // First line of a text file.
 std::string FirstLine(const fs::path& p) {
@@ -75,7 +67,8 @@ TEST(SummaryCsv, HeaderStartsWithTheRequiredColumnsInOrder) {
   EXPECT_EQ(header.substr(0, required.size()), required);
   EXPECT_EQ(header.substr(required.size(), 23), ",specific_energy_kWh_t,");
   // The energy ledger's columns come last.
-  const std::string ledger = ",t10_resolved,comminution_efficiency,ledger_residual_fraction,max_element_speed_m_s";
+  const std::string ledger =
+      ",t10_resolved,comminution_efficiency,ledger_residual_fraction,max_element_speed_m_s";
   ASSERT_GT(header.size(), ledger.size());
   EXPECT_EQ(header.substr(header.size() - ledger.size()), ledger);
   EXPECT_EQ(SummaryCsvColumns().size(), 24u);
@@ -208,9 +201,11 @@ TEST(FractionsCsv, BadFilesAreNamedWithLineAndColumn) {
     }
     return std::string("no error");
   };
-  const std::string header = "velocity_m_s,angle_deg,repeat,fraction_index,d_low_rel,d_high_rel,mass_fraction\n";
+  const std::string header =
+      "velocity_m_s,angle_deg,repeat,fraction_index,d_low_rel,d_high_rel,mass_fraction\n";
   EXPECT_NE(message("a,b\n").find("fractions.csv:1: header"), std::string::npos);
-  EXPECT_NE(message(header + "1,90,0,0,0,0.05,x\n").find("fractions.csv:2: mass_fraction: expected a number"),
+  EXPECT_NE(message(header + "1,90,0,0,0,0.05,x\n")
+                .find("fractions.csv:2: mass_fraction: expected a number"),
             std::string::npos);
   EXPECT_NE(message(header + "1,90,0,1.5,0,0.05,0\n").find("fraction_index"), std::string::npos);
   EXPECT_NE(message(header + "1,90,0\n").find("fractions.csv:2: 3 values"), std::string::npos);
@@ -393,7 +388,8 @@ std::string UnitOf(hid_t file, const std::string& name) {
 TEST(BreakageH5, EnergyGroupWithUnitsAndItsMerge) {
   const auto dir = TestDir();
   const std::string a = (dir / "a.h5").string(), b = (dir / "b.h5").string();
-  const EnergyLedger ledger = ReadEnergyLedger(std::string(MILL_POST_TEST_DATA) + "/ledger_small.csv");
+  const EnergyLedger ledger =
+      ReadEnergyLedger(std::string(MILL_POST_TEST_DATA) + "/ledger_small.csv");
   WriteBreakageH5(a, {MakeImpact(150.0, 0)});
   WriteEnergyLedgerH5(a, ledger);
   WriteEnergyLedgerH5(a, ledger);  // replaced, not duplicated
