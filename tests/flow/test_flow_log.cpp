@@ -7,7 +7,8 @@
 #include <sstream>
 
 #include "geometry/mill_geometry.h"
-#include "stages/flow_stage.h"
+#include "stages/flow/case_files.h"
+#include "stages/flow/foam_results.h"
 
 namespace fs = std::filesystem;
 using namespace mill::flow;
@@ -127,9 +128,9 @@ TEST(FlowTemplate, RotorZoneEndsBetweenFlywheelAndWalls) {
   const fs::path project = MILL_PROJECT_DIR;
   for (const char* domain : {"half", "full"})
     for (const char* width : {"0.3", "0.45"}) {
-      const auto cfg = mill::config::load_case(
-          project / "cases" / "default.yaml", project,
-          {{"flow.domain", domain}, {"mill.flywheel.plate_width", width}});
+      const auto cfg =
+          mill::config::load_case(project / "cases" / "default.yaml", project,
+                                  {{"flow.domain", domain}, {"mill.flywheel.plate_width", width}});
       const double pw = cfg.doc.real("mill.flywheel.plate_width");
       const double wall = 0.5 * cfg.doc.real("mill.housing.depth");
       const std::string p = case_parameters(cfg.doc, 2000, mesh_preset("quick"), 1);
@@ -138,8 +139,10 @@ TEST(FlowTemplate, RotorZoneEndsBetweenFlywheelAndWalls) {
       EXPECT_NEAR(z2, 0.5 * (0.5 * pw + wall), 1e-9);
       EXPECT_GT(z2, 0.5 * pw);
       EXPECT_LT(z2, wall);
-      if (std::string(domain) == "full") EXPECT_NEAR(z1, -z2, 1e-9);
-      else EXPECT_LT(z1, 0.0);  // the half domain's zone reaches through the symmetry plane
+      if (std::string(domain) == "full")
+        EXPECT_NEAR(z1, -z2, 1e-9);
+      else
+        EXPECT_LT(z1, 0.0);  // the half domain's zone reaches through the symmetry plane
       // The refinement cylinder still spans the whole depth.
       EXPECT_GT(zone_z(p, "axisPoint2"), wall);
     }
