@@ -1,5 +1,5 @@
 #!/bin/sh
-# Benchmark of fix bond/breakable (issue 3): bonded lump vs the same lump
+# Benchmark of fix bond/breakable: bonded lump vs the same lump
 # without bonds, one core each, one after the other.
 # Usage: [VEL=150] [STEPS=60000] bench/bond_lump/run.sh [BUILD_DIR] [WORK_DIR]
 #   BUILD_DIR defaults to ./build (needs bin/ or liggghts_styles/ liggghts-mill)

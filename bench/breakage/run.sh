@@ -1,5 +1,5 @@
 #!/bin/sh
-# Breakage benchmarks (issue 4); figures go to bench/README.md.
+# Breakage benchmarks; figures go to bench/README.md.
 #   bench/breakage/run.sh [build-dir]        one reference impact, 150 m/s, 6 ms, 1 core
 #   SWEEP=1 bench/breakage/run.sh [build]    the reference sweep of cases/reference.yaml, --jobs 2
 #   NP=1 SWEEP=1 bench/breakage/run.sh      the same with 1 MPI rank per impact (case: 2); on a

@@ -1,5 +1,5 @@
 #!/bin/sh
-# In-mill breakage benchmark (issue 14); figures go to bench/README.md.
+# In-mill breakage benchmark; figures go to bench/README.md.
 #   bench/in_mill/run.sh [build-dir]
 #   DURATION=0.005 bench/in_mill/run.sh      a shorter run (s) for comparing settings
 # The reference lump (3344 elements, the reference calibration's bonds) in the

@@ -6,6 +6,8 @@
 #include <array>
 #include <sstream>
 
+#include "lump/bond_parameters.h"
+
 namespace mill::config {
 namespace {
 
@@ -43,6 +45,16 @@ KeyDef choice(std::string path, std::string def, std::vector<std::string> choice
 }
 KeyDef opt(KeyDef k) {
   k.optional = true;
+  return k;
+}
+// A bond parameter's key (`path`) with the unit, range and doc of its row
+// in kBondParameters.
+KeyDef bond_key(std::string path, const BondParameter& p, std::string def) {
+  KeyDef k = key(std::move(path), KeyType::Real, p.unit, std::move(def), p.doc);
+  k.min = p.range.min;
+  k.min_exclusive = p.range.min_exclusive;
+  if (p.range.max != kNoBound) k.max = p.range.max;
+  k.max_exclusive = p.range.max_exclusive;
   return k;
 }
 KeyDef matching(KeyDef k, std::string pattern, std::string text) {
@@ -170,7 +182,7 @@ Schema make_case_schema() {
       at_least(key("lump.seed", T::Int, "", "1001", "Seed of the first packing"), 1),
       at_least(key("lump.bond_gap", T::Real, "", "0.15", "Bond pairs whose gap is below this x min(Ri, Rj) (0.15: coordination ~6.3 at 3344 elements)"), 0),
       at_least(key("lump.max_bonds", T::Int, "", "16", "Cap of bonds per element"), 1),
-      positive(key("lump.bond_radius_multiplier", T::Real, "", "1.0", "Bond disc radius = multiplier x min(Ri, Rj)")),
+      bond_key("lump.bond_radius_multiplier", bond_parameter("radius_multiplier"), "1.0"),
       key("lump.broken_contact", T::Bool, "", "false",
           "Broken bonds stay as compression-only frictional contacts while the pair is within its bonding range (fix bond/breakable broken_contact)"),
 
@@ -258,15 +270,14 @@ Schema make_ore_schema() {
       opt(range(key("jk.A", T::Real, "%", "", "Measured JK breakage parameter A: the largest t10 of the ore (drop-weight test); give with jk.b"), 0, true, 100, false)),
       opt(range(key("jk.b", T::Real, "t/kWh", "", "Measured JK breakage parameter b (t10 = A (1 - exp(-b Ecs)), Ecs in kWh/t); give with jk.A"), 0, true, 100, false)),
       opt(key("jk.source", T::String, "", "", "Where the measured A and b come from (laboratory, report)")),
-      // Calibrated micro parameters: written by `--stage calibrate`, optional.
-      opt(positive(key("calibrated.bond_modulus", T::Real, "Pa", "", "Bond modulus E_b (k_n = E_b / L)"))),
-      opt(positive(key("calibrated.stiffness_ratio", T::Real, "", "", "Bond normal/shear stiffness ratio"))),
-      opt(positive(key("calibrated.bond_tensile_strength", T::Real, "Pa", "", "Bond tensile strength"))),
-      opt(positive(key("calibrated.bond_cohesion", T::Real, "Pa", "", "Bond shear cohesion"))),
-      opt(range(key("calibrated.bond_friction_angle", T::Real, "deg", "", "Bond Mohr-Coulomb friction angle"), 0, false, 90, true)),
-      opt(range(key("calibrated.bond_moment_factor", T::Real, "", "", "Share of the bond moments in the bond stresses (absent: 1)"), 0, false, 1, false)),
-      opt(key("calibrated.input_hash", T::String, "", "", "Hash of the macro properties these were fitted to")),
   };
+  // Calibrated micro parameters (written by `--stage calibrate`, optional):
+  // one key per fitted row of kBondParameters, and the hash they were fitted to.
+  for (const BondParameter& p : kBondParameters)
+    if (p.calibrated)
+      s.keys.push_back(opt(bond_key(std::string(kCalibratedSection) + "." + p.calibrated, p, "")));
+  s.keys.push_back(opt(key(std::string(kCalibratedSection) + "." + kInputHashKey, T::String, "", "",
+                           "Hash of the macro properties these were fitted to")));
   return s;
 }
 

@@ -1,4 +1,4 @@
-// Stage 'calibrate': bond parameters from the ore card's macro properties (issue 5).
+// Stage 'calibrate': bond parameters from the ore card's macro properties.
 // The job packs and carves the specimens (calibrate/specimen), runs the lab
 // tests (calibrate/lab_runs), fits (calibrate/fitting) and writes the
 // outputs (calibrate/outputs); this file plans, orchestrates and publishes.
@@ -11,6 +11,7 @@
 
 #include "jobs/job_store.h"
 #include "jobs/output_checks.h"
+#include "lump/bond_parameters.h"
 #include "progress.h"
 #include "stages/calibrate/fitting.h"
 #include "stages/calibrate/lab_runs.h"
@@ -25,28 +26,21 @@ namespace fs = std::filesystem;
 namespace {
 using namespace calibrate;
 
-// Bumped when a deck or the fitting scheme changes what a calibration gives.
-// 2 (Nov 2026): signed bond tension, moment factor and friction-angle levers.
-constexpr int kDeckVersion = 3;  // the energy ledger, midpoint bond increments
-
-const char* kCalibratedKeys[] = {"calibrated.bond_modulus",          "calibrated.stiffness_ratio",
-                                 "calibrated.bond_tensile_strength", "calibrated.bond_cohesion",
-                                 "calibrated.bond_friction_angle",   "calibrated.input_hash"};
+// Bumped when a deck or the fitting scheme changes what a calibration gives
+// (git log of this line: what each version changed).
+constexpr int kDeckVersion = 3;
 
 // True when the ore card carries a complete calibrated.* section fitted to
 // its own macro properties (same input_hash).
 bool card_is_calibrated(const config::CaseConfig& cfg) {
-  for (const char* k : kCalibratedKeys)
-    if (!cfg.ore.has(k)) return false;
-  return cfg.ore.str("calibrated.input_hash") == ore_hash(cfg.ore);
+  return card_has_calibration(cfg.ore) &&
+         cfg.ore.str(std::string(kCalibratedSection) + "." + kInputHashKey) == ore_hash(cfg.ore);
 }
 
 // True when the card carries a complete calibrated.* section fitted to other
 // properties (a stale calibration): the fit then starts from it.
 bool card_has_stale_calibration(const config::CaseConfig& cfg) {
-  for (const char* k : kCalibratedKeys)
-    if (!cfg.ore.has(k)) return false;
-  return !card_is_calibrated(cfg);
+  return card_has_calibration(cfg.ore) && !card_is_calibrated(cfg);
 }
 
 // Everything one calibration run needs, gathered from the case.
@@ -101,7 +95,7 @@ void Calibration::run() {
   BondParams p = estimate_bond_params(ore_, d_.real("lump.bond_radius_multiplier"));
   if (card_has_stale_calibration(ctx_.cfg)) {
     // A changed card: start from its previous calibration, not from scratch.
-    p = card_calibration(ore_, p);
+    p = read_calibrated(ore_, p);
     notes.push_back(
         "started from the ore card's calibrated.* section, fitted to other properties (stale "
         "input_hash)");
@@ -162,13 +156,7 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
   if (card_has_stale_calibration(ctx.cfg)) {
     // The fit starts from the card's stale calibration (read as the fit
     // reads it, optional moment factor included): part of the inputs.
-    const BondParams b = card_calibration(ctx.cfg.ore);
-    in["start"] = {{"calibrated.bond_modulus", b.modulus},
-                   {"calibrated.stiffness_ratio", b.stiffness_ratio},
-                   {"calibrated.bond_tensile_strength", b.tensile},
-                   {"calibrated.bond_cohesion", b.cohesion},
-                   {"calibrated.bond_friction_angle", b.friction_angle_deg},
-                   {"calibrated.bond_moment_factor", b.moment_factor}};
+    in["start"] = bond_json(read_calibrated(ctx.cfg.ore, BondParams{}), BondNames::card);
   }
   if (from_card) {
     in["from_card"] = true;
@@ -204,8 +192,9 @@ void CalibrateStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pa
 // The job's calibrated.yaml (and, after a fit, report.json) exist and parse.
 std::string CalibrateStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
   const fs::path dir = jobs::JobStore(ctx.stage_dir).job_dir(job.label);
-  return jobs::first_problem({jobs::check_yaml_map(dir / "calibrated.yaml"),
-                              job.inputs.contains("from_card") ? "" : jobs::check_json(dir / "report.json")});
+  return jobs::first_problem(
+      {jobs::check_yaml_map(dir / "calibrated.yaml"),
+       job.inputs.contains("from_card") ? "" : jobs::check_json(dir / "report.json")});
 }
 
 // Publish the job's outputs as the stage's: calibrate/calibrated.yaml, reports, plots.

@@ -26,9 +26,9 @@ namespace {
 
 using post::kPi;
 constexpr double kG = 9.81;
-// 1: first version (issue 14).
-// 2: hub of 24 facets, skin of one mean element radius.
-constexpr int kInMillDeckVersion = 4;  // the walls in two fixes, each force's work measured
+// Bumped whenever the in-mill deck changes what a run gives (git log of this
+// line: what each version changed).
+constexpr int kInMillDeckVersion = 4;
 // Facets of the flywheel's hub circle in the in-mill runs (see run_in_mill).
 constexpr int kHubFacets = 24;
 // Neighbour skin in mean element radii: the turning flywheel forces a list
@@ -111,7 +111,7 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan) {
     for (const char* p : {"gas.", "flow.", "sample."}) keys.push_back(p);
   nlohmann::json base = case_keys(d, keys);
   base["ore"] = ore_keys(ctx.cfg.ore);
-  base["bond"] = bond_json(bond_params_for(ctx.cfg, ctx.run_dir));
+  base["bond"] = bond_json(bond_params_for(ctx.cfg, ctx.run_dir), BondNames::job);
   base["in_mill_deck_version"] = kInMillDeckVersion;
   base["mode"] = "in_mill";
   base["rpm"] = rpm;

@@ -107,16 +107,6 @@ long read_long(const fs::path& f) {
 
 }  // namespace
 
-nlohmann::json bond_json(const BondParams& b) {
-  return {{"modulus", b.modulus},
-          {"stiffness_ratio", b.stiffness_ratio},
-          {"tensile", b.tensile},
-          {"cohesion", b.cohesion},
-          {"friction_angle_deg", b.friction_angle_deg},
-          {"radius_multiplier", b.radius_multiplier},
-          {"moment_factor", b.moment_factor}};
-}
-
 LumpRun prepare_lump_run(StageContext& ctx, int repeat, const fs::path& out_dir,
                          const std::string& label) {
   const auto& d = ctx.cfg.doc;
@@ -206,7 +196,7 @@ nlohmann::json lump_result_json(const LumpRun& run, const LumpRunResult& a, doub
             {"outer_diameter_m", 2 * run.lump.outer_radius},
             {"mean_element_radius_m", run.lump.mean_radius},
             {"coordination", run.lump.coordination}}},
-          {"bond_parameters", bond_json(run.bond)},
+          {"bond_parameters", bond_json(run.bond, BondNames::job)},
           {"bond_parameters_origin", run.bond.origin},
           {"n_pieces", s.n_pieces},
           {"n_single", s.n_single},

@@ -74,6 +74,4 @@ void write_lump_outputs(const std::filesystem::path& out_dir, const LumpRunResul
 // The outputs write_lump_outputs writes exist and parse: "" or the reason.
 std::string damaged_lump_outputs(const std::filesystem::path& dir);
 
-nlohmann::json bond_json(const BondParams& b);
-
 }  // namespace mill

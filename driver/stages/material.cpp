@@ -4,6 +4,8 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
+
 #include "engine/liggghts.h"
 #include "jobs/job_store.h"
 #include "stages/stage_util.h"
@@ -21,36 +23,32 @@ BondParams estimate_bond_params(const config::Document& ore, double radius_multi
   // The Mohr-Coulomb shear strength (cohesion + tan(phi) sigma_c) lets the
   // compressive/tensile ratio exceed what pure tension/shear bonds reach.
   BondParams b;
+  for (const BondParameter& p : kBondParameters)
+    if (!std::isnan(p.start)) b.*p.value = p.start;  // the rows with a constant start
   b.modulus = ore.real("youngs_modulus");
-  b.stiffness_ratio = 2.5;
   b.tensile = 2.0 * ore.real("tensile_strength");
   b.cohesion = 2.0 * b.tensile;
-  b.friction_angle_deg = 30.0;
-  b.moment_factor = 1.0;
   b.radius_multiplier = radius_multiplier;
   b.origin = "closed-form estimate (not calibrated: run --stage calibrate)";
   return b;
 }
 
 namespace {
-// Read calibrated.* from a YAML file if fitted to `hash`; false otherwise.
-bool read_calibrated(const fs::path& file, const std::string& hash, BondParams& b) {
+// Read the calibrated: map of a YAML file (calibrated.yaml or the ore card)
+// if fitted to `hash`; false otherwise.
+bool read_calibrated_file(const fs::path& file, const std::string& hash, BondParams& b) {
   if (!fs::exists(file)) return false;
   try {
     YAML::Node root = YAML::LoadFile(file.string());
-    YAML::Node c = root.IsMap() ? root["calibrated"] : YAML::Node();
-    if (!c || !c.IsMap() || !c["input_hash"] || c["input_hash"].as<std::string>() != hash) return false;
-    b.modulus = c["bond_modulus"].as<double>();
-    b.stiffness_ratio = c["stiffness_ratio"].as<double>();
-    b.tensile = c["bond_tensile_strength"].as<double>();
-    b.cohesion = c["bond_cohesion"].as<double>();
-    b.friction_angle_deg = c["bond_friction_angle"].as<double>();
-    // Absent from calibrations made before Nov 2026 (then always 1).
-    b.moment_factor = c["bond_moment_factor"] ? c["bond_moment_factor"].as<double>() : 1.0;
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(fmt::format("{}: damaged calibration ({}); rerun `orchestrate --stage calibrate` (or "
-                                         "repair the file)",
-                                         file.string(), e.what()));
+    YAML::Node c = root.IsMap() ? root[kCalibratedSection] : YAML::Node();
+    if (!c || !c.IsMap() || !c[kInputHashKey] || c[kInputHashKey].as<std::string>() != hash)
+      return false;
+    b = read_calibrated(c, b);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(
+        fmt::format("{}: damaged calibration ({}); rerun `orchestrate --stage calibrate` (or "
+                    "repair the file)",
+                    file.string(), e.what()));
   }
   b.origin = "calibrated (" + file.string() + ")";
   return true;
@@ -62,27 +60,24 @@ BondParams bond_params_for(const config::CaseConfig& cfg, const fs::path& run_di
   BondParams b = estimate_bond_params(cfg.ore, lambda);
   const std::string hash = ore_hash(cfg.ore);
   BondParams c = b;
-  if (read_calibrated(run_dir / "calibrate" / "calibrated.yaml", hash, c)) return c;
-  if (read_calibrated(cfg.ore_file, hash, c)) return c;
+  if (read_calibrated_file(run_dir / "calibrate" / "calibrated.yaml", hash, c)) return c;
+  if (read_calibrated_file(cfg.ore_file, hash, c)) return c;
   return b;
 }
 
-std::vector<std::pair<std::string, std::string>> material_vars(const config::Document& ore, const BondParams& b,
+std::vector<std::pair<std::string, std::string>> material_vars(const config::Document& ore,
+                                                               const BondParams& b,
                                                                const config::Document& doc) {
   using engine::num;
-  return {{"E", num(ore.real("youngs_modulus"))},
-          {"nu", num(ore.real("poisson_ratio"))},
-          {"density", num(ore.real("density"))},
-          {"restitution", num(ore.real("restitution"))},
-          {"friction", num(ore.real("friction"))},
-          {"bond_modulus", num(b.modulus)},
-          {"stiffness_ratio", num(b.stiffness_ratio)},
-          {"bond_tensile", num(b.tensile)},
-          {"bond_cohesion", num(b.cohesion)},
-          {"bond_friction", num(b.friction_angle_deg)},
-          {"moment_factor", num(b.moment_factor)},
-          {"broken_contact", doc.boolean("lump.broken_contact") ? "yes" : "no"},
-          {"radius_mult", num(b.radius_multiplier)}};
+  std::vector<std::pair<std::string, std::string>> v = {
+      {"E", num(ore.real("youngs_modulus"))},
+      {"nu", num(ore.real("poisson_ratio"))},
+      {"density", num(ore.real("density"))},
+      {"restitution", num(ore.real("restitution"))},
+      {"friction", num(ore.real("friction"))}};
+  for (auto& kv : bond_deck_vars(b)) v.push_back(std::move(kv));
+  v.emplace_back("broken_contact", doc.boolean("lump.broken_contact") ? "yes" : "no");
+  return v;
 }
 
 }  // namespace mill

@@ -1,25 +1,16 @@
 // Ore material for the LIGGGHTS decks: contact properties from the ore card,
-// bond (micro) parameters from a calibration or closed-form estimates.
+// bond (micro) parameters (lump/bond_parameters.h) from a calibration or
+// closed-form estimates.
 #pragma once
 
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "lump/bond_parameters.h"
 #include "stages/stage.h"
 
 namespace mill {
-
-struct BondParams {
-  double modulus = 0;             // bond modulus E_b, Pa
-  double stiffness_ratio = 0;     // kn/ks
-  double tensile = 0;             // bond tensile strength, Pa
-  double cohesion = 0;            // bond shear cohesion, Pa
-  double friction_angle_deg = 0;  // bond Mohr-Coulomb friction angle, deg
-  double moment_factor = 1.0;     // beta: share of the bond moments in the bond stresses
-  double radius_multiplier = 1.0;
-  std::string origin;             // where they come from, for reports
-};
 
 // Hash of an ore card's macro properties (what a calibration was fitted to).
 std::string ore_hash(const config::Document& ore);
@@ -32,9 +23,11 @@ BondParams estimate_bond_params(const config::Document& ore, double radius_multi
 // properties), the closed-form estimates.
 BondParams bond_params_for(const config::CaseConfig& cfg, const std::filesystem::path& run_dir);
 
-// -var pairs of the impact and lab-test decks: contacts, bonds, and the bond
-// model's options from the case (lump.broken_contact).
-std::vector<std::pair<std::string, std::string>> material_vars(const config::Document& ore, const BondParams& b,
+// -var pairs of the impact and lab-test decks: contacts, bonds
+// (bond_deck_vars), and the bond model's options from the case
+// (lump.broken_contact).
+std::vector<std::pair<std::string, std::string>> material_vars(const config::Document& ore,
+                                                               const BondParams& b,
                                                                const config::Document& doc);
 
 }  // namespace mill

@@ -1,4 +1,4 @@
-// Stage 'transport': ore lumps through the sampled flow (issue 7).
+// Stage 'transport': ore lumps through the sampled flow.
 #include "stages/transport_stage.h"
 
 #include <fmt/format.h>

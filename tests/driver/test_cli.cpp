@@ -40,6 +40,7 @@ Out orchestrate(const std::string& args) {
 
 const std::string kProject = MILL_PROJECT_DIR;
 const std::string kData = MILL_TEST_DATA;
+const std::string kBadInput = MILL_BAD_INPUT_DIR;
 
 TEST(Cli, HelpHasExamples) {
   auto o = orchestrate("--help");
@@ -62,7 +63,7 @@ TEST(Cli, UnknownStageSuggests) {
 }
 
 TEST(Cli, BadCaseExitsTwoNamingKey) {
-  auto o = orchestrate("--case " + kData + "/bad_unknown_key.yaml --stage all --dry-run");
+  auto o = orchestrate("--case " + kBadInput + "/bad_unknown_key.yaml --stage all --dry-run");
   EXPECT_EQ(o.status, 2);
   EXPECT_NE(o.text.find("rotor.rmp"), std::string::npos) << o.text;
   EXPECT_FALSE(fs::exists(fs::temp_directory_path() / ("mill_cli_" + std::to_string(getpid())) / "runs" / "bad"));

@@ -13,12 +13,13 @@ using mill::config::load_case;
 namespace {
 
 const fs::path kData = MILL_TEST_DATA;
+const fs::path kBadInput = MILL_BAD_INPUT_DIR;
 const fs::path kProject = MILL_PROJECT_DIR;
 
-// Load a bad case and return the error text (fails the test if none).
+// Load a bad case from tests/bad_input/ and return the error text (fails the test if none).
 std::string error_of(const std::string& file) {
   try {
-    load_case(kData / file, kProject);
+    load_case(kBadInput / file, kProject);
   } catch (const ConfigError& e) {
     return e.what();
   }

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Real Slurm test (issue 8): a one-node cluster on localhost runs the job-array
+# Real Slurm test: a one-node cluster on localhost runs the job-array
 # scripts that `orchestrate hpc --stage breakage-report` writes for a
 # three-impact breakage campaign, then the dependent merge job and the report
 # job; checks every array task, the merge and the report job completed with

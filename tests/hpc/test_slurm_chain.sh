@@ -1,5 +1,5 @@
 #!/bin/sh
-# Real Slurm test (issue 16): the whole campaign of a tiny case as one chain of
+# Real Slurm test: the whole campaign of a tiny case as one chain of
 # dependent jobs on a one-node cluster (slurm_cluster.sh), from
 # `orchestrate hpc --stage all`: flow (array, 2 MPI ranks), sample, transport
 # (array), calibrate, a planning job that sizes the breakage array from the

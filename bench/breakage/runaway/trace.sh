@@ -1,5 +1,5 @@
 #!/bin/sh
-# The runaway element of issue 26, traced step by step (bench/README.md,
+# The runaway element of a high-speed impact, traced step by step (bench/README.md,
 # "Energy ledger"): the 3344-element reference lump at 150 m/s with the
 # reference calibration's bonds, once with LIGGGHTS's two-sided primitive
 # plane (the impact surface before the fix) and once with the deck as it is

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Flow study table (issue 13): one row per run folder of bench/flow/study/run.sh.
+"""Flow study table: one row per run folder of bench/flow/study/run.sh.
 
 Usage: summarize.py runs/flow_study_*     prints two Markdown tables (flow; impacts)
 and the spread (max - min over mean) of each column over the runs given.

@@ -80,9 +80,9 @@ BondParams Fitting::update(const std::vector<Iteration>& hist,
     const bool far_below = have * kCoarseLeverGap < want;
     if (far_below && p.moment_factor > 0.0) {
       p.moment_factor = 0.0;
-      notes.push_back(fmt::format(
-          "iteration {}: UCS/tensile {:.2f} (card {:.1f}): moment factor {:g} -> 0", hist.size(),
-          have, want, now.p.moment_factor));
+      notes.push_back(
+          fmt::format("iteration {}: UCS/tensile {:.2f} (card {:.1f}): moment factor {:g} -> 0",
+                      hist.size(), have, want, now.p.moment_factor));
     } else if (far_below && p.friction_angle_deg < kMaxFrictionAngle) {
       p.friction_angle_deg = kMaxFrictionAngle;
       notes.push_back(fmt::format(
@@ -124,18 +124,6 @@ size_t Fitting::best(const std::vector<Iteration>& hist) const {
         (met(hist[i]) == met(hist[best]) && hist[i].score < hist[best].score))
       best = i;
   return best;
-}
-
-// The ore card's calibrated.* values in place of those of base.
-BondParams card_calibration(const config::Document& ore, BondParams base) {
-  base.modulus = ore.real("calibrated.bond_modulus");
-  base.stiffness_ratio = ore.real("calibrated.stiffness_ratio");
-  base.tensile = ore.real("calibrated.bond_tensile_strength");
-  base.cohesion = ore.real("calibrated.bond_cohesion");
-  base.friction_angle_deg = ore.real("calibrated.bond_friction_angle");
-  base.moment_factor =
-      ore.has("calibrated.bond_moment_factor") ? ore.real("calibrated.bond_moment_factor") : 1.0;
-  return base;
 }
 
 }  // namespace mill::calibrate

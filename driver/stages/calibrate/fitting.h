@@ -55,8 +55,4 @@ class Fitting {
   double tol_;
 };
 
-// The ore card's calibrated.* values in place of those of base (the rest of
-// base kept): the fit's start when the card's section is stale.
-BondParams card_calibration(const config::Document& ore, BondParams base = {});
-
 }  // namespace mill::calibrate

@@ -11,6 +11,7 @@
 
 #include "engine/runner.h"
 #include "jobs/job_store.h"
+#include "lump/bond_parameters.h"
 #include "progress.h"
 #include "stages/calibrate/energy_report.h"
 
@@ -18,17 +19,6 @@ namespace mill::calibrate {
 namespace fs = std::filesystem;
 
 namespace {
-
-// Bond parameters as JSON, with the calibrated.yaml key names.
-nlohmann::json bond_json(const BondParams& b) {
-  return {{"bond_modulus", b.modulus},
-          {"stiffness_ratio", b.stiffness_ratio},
-          {"bond_tensile_strength", b.tensile},
-          {"bond_cohesion", b.cohesion},
-          {"bond_friction_angle", b.friction_angle_deg},
-          {"bond_moment_factor", b.moment_factor},
-          {"radius_multiplier", b.radius_multiplier}};
-}
 
 // The macro properties an iteration achieved, with the ore card's key names.
 nlohmann::json macro(const Iteration& it) {
@@ -52,20 +42,6 @@ void append_curves(std::ostream& o, const std::string& run, int iteration, const
     o << fmt::format("{},{},{},{:.6g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", run, iteration, test,
                      rate, c.displacement[i], c.force(i), strain[i], stress[i],
                      c.lateral_strain[i]);
-}
-
-// The calibrated: map that material.cpp reads (and that may be pasted into
-// the ore card), fitted to the card whose ore_hash is `hash`.
-void emit_calibrated(YAML::Emitter& y, const BondParams& b, const std::string& hash) {
-  y << YAML::Key << "calibrated" << YAML::Value << YAML::BeginMap;
-  y << YAML::Key << "bond_modulus" << YAML::Value << b.modulus;
-  y << YAML::Key << "stiffness_ratio" << YAML::Value << b.stiffness_ratio;
-  y << YAML::Key << "bond_tensile_strength" << YAML::Value << b.tensile;
-  y << YAML::Key << "bond_cohesion" << YAML::Value << b.cohesion;
-  y << YAML::Key << "bond_friction_angle" << YAML::Value << b.friction_angle_deg;
-  y << YAML::Key << "bond_moment_factor" << YAML::Value << b.moment_factor;
-  y << YAML::Key << "input_hash" << YAML::Value << hash;
-  y << YAML::EndMap;
 }
 
 // The outputs of one finished fit, each built from the same facts.
@@ -187,7 +163,7 @@ nlohmann::json Report::json() const {
     const auto& it = hist_[i];
     iters.push_back(
         {{"iteration", i + 1},
-         {"bond", bond_json(it.p)},
+         {"bond", bond_json(it.p, BondNames::report)},
          {"achieved", macro(it)},
          {"errors",
           {{"youngs_modulus", it.err_E},
@@ -241,7 +217,7 @@ nlohmann::json Report::json() const {
       {"converged", b_.converged},
       {"best_iteration", best_ + 1},
       {"iterations", iters},
-      {"calibrated", bond_json(b_.p)},
+      {"calibrated", bond_json(b_.p, BondNames::report)},
       {"specimen", specimen},
       {"strain_rate_1_s", rate_},
       {"rate_check", half_ ? nlohmann::json{{"strain_rate_1_s", 0.5 * rate_},
@@ -440,7 +416,7 @@ void copy_from_card(StageContext& ctx, const fs::path& dir) {
   YAML::Emitter y;
   y.SetDoublePrecision(8);
   y << YAML::BeginMap;
-  emit_calibrated(y, card_calibration(o), hash);
+  emit_calibrated(y, read_calibrated(o, BondParams{}), hash);
   y << YAML::Key << "ore" << YAML::Value << o.str("name") << YAML::Key << "source" << YAML::Value
     << "ore card " + ctx.cfg.ore_file.string() << YAML::EndMap;
   const nlohmann::json report = {

@@ -1,0 +1,132 @@
+// The bond (micro) parameters of fix bond/breakable and their one table of
+// keys: per parameter its name in the ore card's calibrated: section and in
+// calibrated.yaml, the deck variable, the style's keyword, the key in a job's
+// JSON, the unit, the admissible range and the starting value. The ore
+// card's schema (config/schema.cpp), the JSON, the calibrated: map and the
+// decks' -var pairs are all derived from kBondParameters: a new parameter is
+// one member of BondParams and one row (plus its deck variable and the
+// style's keyword). This header includes nothing of driver/, so that the
+// config schema can read the table.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace mill {
+namespace config {
+class Document;
+}
+
+// One set of bond parameters; each number is a row of kBondParameters.
+struct BondParams {
+  double modulus = 0;             // bond modulus E_b, Pa
+  double stiffness_ratio = 0;     // kn/ks
+  double tensile = 0;             // bond tensile strength, Pa
+  double cohesion = 0;            // bond shear cohesion, Pa
+  double friction_angle_deg = 0;  // bond Mohr-Coulomb friction angle, deg
+  double moment_factor = 1.0;     // beta: share of the bond moments in the bond stresses
+  double radius_multiplier = 1.0;
+  std::string origin;  // where they come from, for reports
+};
+
+// Admissible values: min < v (or <=), v < max (or <=).
+struct BondRange {
+  double min;
+  bool min_exclusive;
+  double max;
+  bool max_exclusive;
+};
+inline constexpr double kNoBound = std::numeric_limits<double>::infinity();
+inline constexpr BondRange kPositive{0, true, kNoBound, false};
+
+// A start that is not a constant: estimate_bond_params derives it from the
+// ore card (or the case).
+inline constexpr double kFromCard = std::numeric_limits<double>::quiet_NaN();
+
+// One parameter: a row of the table.
+struct BondParameter {
+  double BondParams::*value;
+  const char* json;        // key in a job's JSON and result.json: bond.<json>
+  const char* calibrated;  // key in calibrated.yaml and the ore card's calibrated.<key>;
+                           // nullptr: not fitted, the case sets it
+  const char* deck;        // deck variable (-var), passed to the style's keyword
+  const char* keyword;     // fix bond/breakable keyword (liggghts_inputs/lump_bonds.in)
+  const char* unit;        // "" = dimensionless
+  BondRange range;
+  double start;   // the closed-form estimate (kFromCard: derived from the card)
+  bool optional;  // may be absent from a calibration (one made before it existed): then `start`
+  const char* doc;
+};
+
+// The table. The names differ between columns only for history (the
+// calibrated.yaml names came with the calibrate stage, the deck names with
+// the first impact deck, the job JSON names are the C++ members'); renaming
+// any of them changes the user's files, decks or job ids, so they stay.
+// Row order is the order of the calibrated: map and of the card's schema.
+// clang-format off
+inline constexpr BondParameter kBondParameters[] = {
+//  member                           json                  calibrated               deck               keyword              unit   range                        start      optional
+  {&BondParams::modulus,            "modulus",            "bond_modulus",          "bond_modulus",    "modulus",           "Pa",  kPositive,                   kFromCard, false,
+   "Bond modulus E_b (k_n = E_b / L)"},
+  {&BondParams::stiffness_ratio,    "stiffness_ratio",    "stiffness_ratio",       "stiffness_ratio", "stiffness_ratio",   "",    kPositive,                   2.5,       false,
+   "Bond normal/shear stiffness ratio"},
+  {&BondParams::tensile,            "tensile",            "bond_tensile_strength", "bond_tensile",    "tensile_strength",  "Pa",  kPositive,                   kFromCard, false,
+   "Bond tensile strength"},
+  {&BondParams::cohesion,           "cohesion",           "bond_cohesion",         "bond_cohesion",   "cohesion",          "Pa",  kPositive,                   kFromCard, false,
+   "Bond shear cohesion"},
+  {&BondParams::friction_angle_deg, "friction_angle_deg", "bond_friction_angle",   "bond_friction",   "friction_angle",    "deg", {0, false, 90, true},        30.0,      false,
+   "Bond Mohr-Coulomb friction angle"},
+  {&BondParams::moment_factor,      "moment_factor",      "bond_moment_factor",    "moment_factor",   "moment_factor",     "",    {0, false, 1, false},        1.0,       true,
+   "Share of the bond moments in the bond stresses (absent: 1)"},
+  {&BondParams::radius_multiplier,  "radius_multiplier",  nullptr,                 "radius_mult",     "radius_multiplier", "",    kPositive,                   kFromCard, false,
+   "Bond disc radius = multiplier x min(Ri, Rj)"},  // the case's lump.bond_radius_multiplier
+};
+// clang-format on
+
+// The ore card's section of fitted parameters, and the key in it (and in
+// calibrated.yaml) that ties them to the card's macro properties.
+inline constexpr const char* kCalibratedSection = "calibrated";
+inline constexpr const char* kInputHashKey = "input_hash";
+
+// The row whose job JSON key is `json`; throws std::logic_error for none.
+inline const BondParameter& bond_parameter(std::string_view json) {
+  for (const BondParameter& p : kBondParameters)
+    if (json == p.json) return p;
+  throw std::logic_error("no bond parameter '" + std::string(json) + "' in kBondParameters");
+}
+
+// Which names a JSON object of the parameters uses.
+enum class BondNames {
+  job,     // every row under its json name (job JSON, result.json)
+  report,  // every row under its calibrated name, else its json name (report.json)
+  card,    // the fitted rows under calibrated.<calibrated> (the card's keys)
+};
+nlohmann::json bond_json(const BondParams& b, BondNames names);
+
+// The calibrated: map of calibrated.yaml (and of the ore card) as a YAML map
+// entry: the fitted rows in table order, then the input hash `hash` (the
+// ore_hash of the card they were fitted to).
+void emit_calibrated(YAML::Emitter& y, const BondParams& b, const std::string& hash);
+
+// `base` with the fitted rows replaced by those of a calibrated: map (a YAML
+// node, or the card's calibrated.* keys); an optional row that is absent
+// takes its start. Throws std::runtime_error naming the key a required row
+// misses, YAML::Exception for a value that is no number.
+BondParams read_calibrated(const YAML::Node& calibrated, BondParams base);
+BondParams read_calibrated(const config::Document& ore, BondParams base);
+
+// True when the ore card's calibrated: section is complete: every required
+// fitted row and the input hash.
+bool card_has_calibration(const config::Document& ore);
+
+// -var pairs of the decks: every row's deck variable, formatted for LIGGGHTS.
+std::vector<std::pair<std::string, std::string>> bond_deck_vars(const BondParams& b);
+
+}  // namespace mill
