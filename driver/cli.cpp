@@ -1,9 +1,9 @@
 // orchestrate's command line.
 #include "cli.h"
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cstdlib>
 #include <filesystem>
@@ -52,10 +52,12 @@ Exit status: 0 ok, 1 a job failed, 2 bad input, 3 stage not implemented yet,
 
 // A CLI11 check: a plain decimal number (no hex, inf or nan) in [lo, hi],
 // a whole number when `integer`. The message reads "expected ..., got '...'".
-CLI::Validator decimal(double lo, double hi, bool integer, const std::string& what, bool lo_open = false) {
-  const std::string range = integer ? fmt::format("a whole number in [{}, {}]", static_cast<long long>(lo),
-                                                  static_cast<long long>(hi))
-                                    : fmt::format("{} in {}{:g}, {:g}]", what, lo_open ? "(" : "[", lo, hi);
+CLI::Validator decimal(double lo, double hi, bool integer, const std::string& what,
+                       bool lo_open = false) {
+  const std::string range =
+      integer ? fmt::format("a whole number in [{}, {}]", static_cast<long long>(lo),
+                            static_cast<long long>(hi))
+              : fmt::format("{} in {}{:g}, {:g}]", what, lo_open ? "(" : "[", lo, hi);
   return CLI::Validator(
       [=](std::string& in) -> std::string {
         static const std::regex real(R"([+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?)");
@@ -79,99 +81,260 @@ void check_output_path(const fs::path& out) {
   for (fs::path p = out; !p.empty(); p = p.parent_path()) {
     if (fs::exists(p, ec)) {
       if (fs::is_directory(p, ec)) return;
-      throw config::ConfigError(
-          p == out ? fmt::format("--output {}: is a file; expected a run folder (a directory, or a path that does not "
-                                 "exist yet)",
-                                 out.string())
-                   : fmt::format("--output {}: {} is a file, so the run folder cannot be made below it; expected a "
-                                 "path under a directory",
-                                 out.string(), p.string()));
+      throw config::ConfigError(p == out
+                                    ? fmt::format("--output {}: is a file; expected a run folder "
+                                                  "(a directory, or a path that does not "
+                                                  "exist yet)",
+                                                  out.string())
+                                    : fmt::format("--output {}: {} is a file, so the run folder "
+                                                  "cannot be made below it; expected a "
+                                                  "path under a directory",
+                                                  out.string(), p.string()));
     }
     if (p == p.parent_path()) return;
+  }
+}
+
+// Everything the command line sets, with its defaults.
+struct CliArgs {
+  std::string case_file = (fs::path(project_dir()) / "cases" / "default.yaml").string();
+  std::string stage, output;
+  int np = 0, jobs = 0, task = -1;
+  bool dry_run = false, list_tasks = false, force = false, print_schema = false, check = false,
+       merge_only = false;
+  // orchestrate impact
+  double imp_velocity = 0, imp_angle = 90;
+  std::string imp_ore;
+  long imp_elements = 0;
+  int imp_repeat = 0;
+  // orchestrate hpc
+  HpcOptions hpc_opt;
+  // orchestrate compare
+  std::vector<std::string> compare_runs;
+};
+
+// The options of a stage run (the main command).
+void add_stage_options(CLI::App& app, CliArgs& a) {
+  app.add_option("-c,--case", a.case_file, "Case file (YAML)")->capture_default_str();
+  app.add_option("-s,--stage", a.stage,
+                 "Stage to run: flow, sample, transport, calibrate, breakage, report, all, or a "
+                 "range FIRST-LAST");
+  app.add_option("-o,--output", a.output, "Run folder (default: runs/<case name>)");
+  app.add_option("--np", a.np, "MPI ranks per engine run (default: resources.np of the case)")
+      ->check(decimal(1, 100000, true, "ranks"));
+  app.add_option("-j,--jobs", a.jobs,
+                 "Engine runs at once on this machine (default: resources.jobs)")
+      ->check(decimal(1, 1024, true, "jobs"));
+  app.add_flag("-n,--dry-run", a.dry_run,
+               "Print the plan (stages, jobs, which are done); run nothing");
+  app.add_flag("--list-tasks", a.list_tasks,
+               "List the jobs of the stage, one per line: index, label, state, summary");
+  app.add_option("--task", a.task, "Run only job I (0-based) of the stage: one HPC array task")
+      ->check(decimal(0, 10000000, true, "task"));
+  app.add_flag("--merge-only", a.merge_only,
+               "Run no job: merge the stage if every job is done, else name the jobs that are "
+               "not and exit 1 (the "
+               "merge job of `orchestrate hpc`)");
+  app.add_flag("-f,--force", a.force, "Redo jobs that are already done");
+  app.add_flag("--print-schema", a.print_schema,
+               "Print every case-file and ore-card key as Markdown");
+  app.add_flag("--check", a.check, "Validate the case file and its ore card, then exit");
+}
+
+// orchestrate impact: one impact, for trying things.
+CLI::App* add_impact_command(CLI::App& app, CliArgs& a) {
+  CLI::App* impact = app.add_subcommand(
+      "impact", "One lump impact (deck + fragment analysis) into --output; prints its figures");
+  // The same bounds as breakage.velocities and breakage.angles in the case schema.
+  const config::KeyDef& vel_key = *config::case_schema().find("breakage.velocities");
+  impact->add_option("-v,--velocity", a.imp_velocity, "Impact speed, m/s")
+      ->required()
+      ->check(decimal(0, *vel_key.max, false, "a speed in m/s", true));
+  impact->add_option("-a,--angle", a.imp_angle, "Angle to the surface, deg (90 = normal)")
+      ->check(decimal(0, 90, false, "an angle in deg", true))
+      ->capture_default_str();
+  impact->add_option("--ore", a.imp_ore,
+                     "Ore card (file or bundled name, e.g. granite); default: the case's");
+  impact
+      ->add_option("--elements", a.imp_elements,
+                   "Elements in the lump; default: the case's lump.n_elements")
+      ->check(decimal(2, 10000000, true, "elements"));
+  impact->add_option("--repeat", a.imp_repeat, "Repeat index (random orientation)")
+      ->check(decimal(0, 1000000, true, "repeat"));
+  impact->footer(
+      "\nExample:\n  orchestrate impact --velocity 100 --angle 60 --ore granite --elements 400 "
+      "--output try1\n");
+  impact->fallthrough();
+  return impact;
+}
+
+// orchestrate hpc: scheduler scripts for a stage or a chain of stages.
+CLI::App* add_hpc_command(CLI::App& app, CliArgs& a) {
+  HpcOptions& o = a.hpc_opt;
+  CLI::App* hpc = app.add_subcommand(
+      "hpc",
+      "Write Slurm scripts for a stage or a range of stages (arrays of one task per job, chained "
+      "with "
+      "--dependency=afterok) and the script that submits them");
+  hpc->add_option("--scheduler", o.scheduler, "Scheduler (slurm)")->capture_default_str();
+  hpc->add_option("--partition", o.partition,
+                  "Slurm partition of every job (default: resources.<stage>.partition)");
+  hpc->add_option("--account", o.account, "Slurm account");
+  hpc->add_option("--time", o.time,
+                  "Wall-time limit of every job (HH:MM:SS; default: resources.<stage>.time)");
+  hpc->add_option("--mem", o.mem, "Memory of every job, e.g. 4G (default: resources.<stage>.mem)");
+  hpc->add_option("--max-parallel", o.max_parallel, "At most this many tasks at once (0: no limit)")
+      ->check(decimal(0, 100000, true, "tasks"));
+  hpc->footer(
+      "\nExamples:\n  orchestrate hpc --scheduler slurm --stage all --case cases/reference.yaml "
+      "--np 16\n"
+      "  sh runs/reference/hpc/submit_all.sh\n"
+      "  orchestrate hpc --scheduler slurm --stage breakage --case cases/reference.yaml\n"
+      "  sh runs/reference/hpc/submit_breakage.sh\n");
+  hpc->fallthrough();
+  return hpc;
+}
+
+// orchestrate compare: several finished runs side by side.
+CLI::App* add_compare_command(CLI::App& app, CliArgs& a) {
+  CLI::App* compare = app.add_subcommand(
+      "compare",
+      "One page (HTML) with the headline numbers and product curves of several finished runs "
+      "side by side");
+  compare
+      ->add_option("runs", a.compare_runs,
+                   "Run folders (runs/<case>), at least two, each finished (report done)")
+      ->required();
+  compare->footer(
+      "\nExample:\n  orchestrate compare runs/default runs/granite --output runs/compare\n"
+      "  (writes runs/compare/index.html; default --output: runs/compare)\n");
+  compare->fallthrough();
+  return compare;
+}
+
+// orchestrate impact: the case with --ore and --elements applied, one impact
+// into --output.
+int impact_command(const CliArgs& a, std::ostream& out) {
+  std::vector<std::pair<std::string, std::string>> ov;
+  if (!a.imp_ore.empty()) ov.push_back({"ore.card", "'" + a.imp_ore + "'"});
+  if (a.imp_elements > 0) ov.push_back({"lump.n_elements", std::to_string(a.imp_elements)});
+  const auto cfg = config::load_case(a.case_file, project_dir(), ov);
+  const fs::path out_dir =
+      a.output.empty()
+          ? fs::path("runs") / fmt::format("impact_v{:g}_a{:g}", a.imp_velocity, a.imp_angle)
+          : fs::path(a.output);
+  RunOptions opts;
+  opts.output = fs::absolute(out_dir);
+  check_output_path(opts.output);
+  check_run_folder(cfg, opts.output, a.force);
+  opts.force = a.force;
+  opts.np = a.np > 0 ? a.np : static_cast<int>(cfg.doc.integer("resources.np"));
+  return run_single_impact(cfg, opts, a.imp_velocity, a.imp_angle, a.imp_repeat, out);
+}
+
+// orchestrate compare: the page of the runs given.
+int compare_command(const CliArgs& a, std::ostream& out) {
+  CompareOptions co;
+  for (const auto& r : a.compare_runs) co.runs.emplace_back(r);
+  co.output = fs::absolute(a.output.empty() ? fs::path("runs") / "compare" : fs::path(a.output));
+  co.project_dir = project_dir();
+  out << write_compare(co);
+  return 0;
+}
+
+// orchestrate hpc: the Slurm scripts of the stages given.
+int hpc_command(const config::CaseConfig& cfg, CliArgs& a, std::ostream& out) {
+  HpcOptions& o = a.hpc_opt;
+  if (a.stage.empty())
+    throw config::ConfigError(
+        "--stage: hpc needs the stages to script: one stage, a range FIRST-LAST or all");
+  o.stages = resolve_stages(a.stage);
+  o.stage = a.stage;
+  o.output = fs::absolute(a.output.empty() ? fs::path("runs") / cfg.name : fs::path(a.output));
+  check_output_path(o.output);
+  check_run_folder(cfg, o.output, a.force);
+  o.np = a.np;  // 0: not given; the stages' resources decide
+  const auto n_tasks = [&](const std::string& s) {
+    Invocation inv;
+    inv.stages = {s};
+    inv.opts.output = o.output;
+    return count_tasks(cfg, inv);
+  };
+  out << write_hpc_scripts(cfg, o, n_tasks, fs::canonical("/proc/self/exe").string());
+  return 0;
+}
+
+// The main command: run (or plan, list, merge) the stages given.
+int stage_command(const config::CaseConfig& cfg, const CliArgs& a, std::ostream& out,
+                  std::ostream& err) {
+  if (a.stage.empty()) {
+    err << "error: --stage: which stage? expected one of flow, sample, transport, calibrate, "
+           "breakage, report, all\n"
+        << "Run 'orchestrate --help' for examples.\n";
+    return kExitBadInput;
+  }
+  Invocation inv;
+  inv.stages = resolve_stages(a.stage);
+  // Absolute: engines and helper scripts run in other working directories.
+  inv.opts.output =
+      fs::absolute(a.output.empty() ? fs::path("runs") / cfg.name : fs::path(a.output));
+  check_output_path(inv.opts.output);
+  check_run_folder(cfg, inv.opts.output, a.force);
+  inv.opts.np = a.np > 0 ? a.np : static_cast<int>(cfg.doc.integer("resources.np"));
+  inv.opts.jobs = a.jobs > 0 ? a.jobs : static_cast<int>(cfg.doc.integer("resources.jobs"));
+  inv.opts.force = a.force;
+  if (const char* job = std::getenv("MILL_SCHEDULER_JOB")) inv.opts.scheduler_job = job;
+  if (const char* log = std::getenv("MILL_SCHEDULER_LOG")) inv.opts.scheduler_log = log;
+  inv.dry_run = a.dry_run;
+  inv.list_tasks = a.list_tasks;
+  inv.merge_only = a.merge_only;
+  if (a.task >= 0) inv.task = a.task;
+  return run_pipeline(cfg, inv, out);
+}
+
+// The exit status of an error thrown by a command, its message written to `err`.
+int error_status(std::ostream& err) {
+  try {
+    throw;
+  } catch (const config::ConfigError& e) {
+    err << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const NotImplemented& e) {
+    err << "error: " << e.what() << "\n";
+    return kExitNotImplemented;
+  } catch (const MissingInput& e) {
+    err << "error: " << e.what() << "\n";
+    return kExitFailed;
+  } catch (const fs::filesystem_error& e) {
+    // A file operation the user's paths or disk made fail: name the path.
+    err << "error: " << (e.path1().empty() ? std::string("a file operation") : e.path1().string())
+        << ": " << e.code().message()
+        << (e.path2().empty() ? "" : " (with " + e.path2().string() + ")")
+        << "\nCheck that the run folder (--output) is a writable directory with free space.\n";
+    return kExitFailed;
+  } catch (const engine::Interrupted& e) {
+    err << "orchestrate: " << e.what()
+        << "; finished jobs are kept, rerun the same command to resume\n";
+    return 128 + e.signal;
+  } catch (const std::exception& e) {
+    err << "error: " << e.what() << "\n";
+    return kExitFailed;
   }
 }
 
 }  // namespace
 
 int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
-  CLI::App app{"orchestrate: beater-mill comminution workflow (OpenFOAM flow, LIGGGHTS transport and breakage)"};
+  CLI::App app{
+      "orchestrate: beater-mill comminution workflow (OpenFOAM flow, LIGGGHTS transport and "
+      "breakage)"};
   app.footer(kExamples);
   app.set_version_flag("--version", std::string("orchestrate ") + MILL_VERSION);
-
-  std::string case_file = (fs::path(project_dir()) / "cases" / "default.yaml").string();
-  std::string stage, output;
-  int np = 0, jobs = 0, task = -1;
-  bool dry_run = false, list_tasks = false, force = false, print_schema = false, check = false, merge_only = false;
-  app.add_option("-c,--case", case_file, "Case file (YAML)")->capture_default_str();
-  app.add_option("-s,--stage", stage,
-                 "Stage to run: flow, sample, transport, calibrate, breakage, report, all, or a range FIRST-LAST");
-  app.add_option("-o,--output", output, "Run folder (default: runs/<case name>)");
-  app.add_option("--np", np, "MPI ranks per engine run (default: resources.np of the case)")
-      ->check(decimal(1, 100000, true, "ranks"));
-  app.add_option("-j,--jobs", jobs, "Engine runs at once on this machine (default: resources.jobs)")
-      ->check(decimal(1, 1024, true, "jobs"));
-  app.add_flag("-n,--dry-run", dry_run, "Print the plan (stages, jobs, which are done); run nothing");
-  app.add_flag("--list-tasks", list_tasks, "List the jobs of the stage, one per line: index, label, state, summary");
-  app.add_option("--task", task, "Run only job I (0-based) of the stage: one HPC array task")
-      ->check(decimal(0, 10000000, true, "task"));
-  app.add_flag("--merge-only", merge_only,
-               "Run no job: merge the stage if every job is done, else name the jobs that are not and exit 1 (the "
-               "merge job of `orchestrate hpc`)");
-  app.add_flag("-f,--force", force, "Redo jobs that are already done");
-  app.add_flag("--print-schema", print_schema, "Print every case-file and ore-card key as Markdown");
-  app.add_flag("--check", check, "Validate the case file and its ore card, then exit");
-
-  // orchestrate impact: one impact, for trying things.
-  double imp_velocity = 0, imp_angle = 90;
-  std::string imp_ore;
-  long imp_elements = 0;
-  int imp_repeat = 0;
-  CLI::App* impact = app.add_subcommand(
-      "impact", "One lump impact (deck + fragment analysis) into --output; prints its figures");
-  // The same bounds as breakage.velocities and breakage.angles in the case schema.
-  const config::KeyDef& vel_key = *config::case_schema().find("breakage.velocities");
-  impact->add_option("-v,--velocity", imp_velocity, "Impact speed, m/s")
-      ->required()
-      ->check(decimal(0, *vel_key.max, false, "a speed in m/s", true));
-  impact->add_option("-a,--angle", imp_angle, "Angle to the surface, deg (90 = normal)")
-      ->check(decimal(0, 90, false, "an angle in deg", true))
-      ->capture_default_str();
-  impact->add_option("--ore", imp_ore, "Ore card (file or bundled name, e.g. granite); default: the case's");
-  impact->add_option("--elements", imp_elements, "Elements in the lump; default: the case's lump.n_elements")
-      ->check(decimal(2, 10000000, true, "elements"));
-  impact->add_option("--repeat", imp_repeat, "Repeat index (random orientation)")
-      ->check(decimal(0, 1000000, true, "repeat"));
-  impact->footer("\nExample:\n  orchestrate impact --velocity 100 --angle 60 --ore granite --elements 400 --output try1\n");
-  impact->fallthrough();
-
-  // orchestrate hpc: scheduler scripts for a stage or a chain of stages.
-  HpcOptions hpc_opt;
-  CLI::App* hpc = app.add_subcommand(
-      "hpc", "Write Slurm scripts for a stage or a range of stages (arrays of one task per job, chained with "
-             "--dependency=afterok) and the script that submits them");
-  hpc->add_option("--scheduler", hpc_opt.scheduler, "Scheduler (slurm)")->capture_default_str();
-  hpc->add_option("--partition", hpc_opt.partition, "Slurm partition of every job (default: resources.<stage>.partition)");
-  hpc->add_option("--account", hpc_opt.account, "Slurm account");
-  hpc->add_option("--time", hpc_opt.time, "Wall-time limit of every job (HH:MM:SS; default: resources.<stage>.time)");
-  hpc->add_option("--mem", hpc_opt.mem, "Memory of every job, e.g. 4G (default: resources.<stage>.mem)");
-  hpc->add_option("--max-parallel", hpc_opt.max_parallel, "At most this many tasks at once (0: no limit)")
-      ->check(decimal(0, 100000, true, "tasks"));
-  hpc->footer("\nExamples:\n  orchestrate hpc --scheduler slurm --stage all --case cases/reference.yaml --np 16\n"
-              "  sh runs/reference/hpc/submit_all.sh\n"
-              "  orchestrate hpc --scheduler slurm --stage breakage --case cases/reference.yaml\n"
-              "  sh runs/reference/hpc/submit_breakage.sh\n");
-  hpc->fallthrough();
-
-  // orchestrate compare: several finished runs side by side.
-  std::vector<std::string> compare_runs;
-  CLI::App* compare = app.add_subcommand(
-      "compare", "One page (HTML) with the headline numbers and product curves of several finished runs side by side");
-  compare->add_option("runs", compare_runs, "Run folders (runs/<case>), at least two, each finished (report done)")
-      ->required();
-  compare->footer("\nExample:\n  orchestrate compare runs/default runs/granite --output runs/compare\n"
-                  "  (writes runs/compare/index.html; default --output: runs/compare)\n");
-  compare->fallthrough();
-
+  CliArgs a;
+  add_stage_options(app, a);
+  const CLI::App* impact = add_impact_command(app, a);
+  const CLI::App* hpc = add_hpc_command(app, a);
+  const CLI::App* compare = add_compare_command(app, a);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -185,100 +348,23 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
 
-  if (print_schema) {
+  if (a.print_schema) {
     out << config::schema_markdown();
     return 0;
   }
   try {
-    if (*impact) {
-      std::vector<std::pair<std::string, std::string>> ov;
-      if (!imp_ore.empty()) ov.push_back({"ore.card", "'" + imp_ore + "'"});
-      if (imp_elements > 0) ov.push_back({"lump.n_elements", std::to_string(imp_elements)});
-      const auto cfg = config::load_case(case_file, project_dir(), ov);
-      const fs::path out_dir = output.empty() ? fs::path("runs") / fmt::format("impact_v{:g}_a{:g}", imp_velocity, imp_angle)
-                                              : fs::path(output);
-      RunOptions opts;
-      opts.output = fs::absolute(out_dir);
-      check_output_path(opts.output);
-      check_run_folder(cfg, opts.output, force);
-      opts.force = force;
-      opts.np = np > 0 ? np : static_cast<int>(cfg.doc.integer("resources.np"));
-      return run_single_impact(cfg, opts, imp_velocity, imp_angle, imp_repeat, out);
-    }
-    if (*compare) {
-      CompareOptions co;
-      for (const auto& r : compare_runs) co.runs.emplace_back(r);
-      co.output = fs::absolute(output.empty() ? fs::path("runs") / "compare" : fs::path(output));
-      co.project_dir = project_dir();
-      out << write_compare(co);
-      return 0;
-    }
-    const auto cfg = config::load_case(case_file, project_dir());
-    if (*hpc) {
-      if (stage.empty())
-        throw config::ConfigError("--stage: hpc needs the stages to script: one stage, a range FIRST-LAST or all");
-      hpc_opt.stages = resolve_stages(stage);
-      hpc_opt.stage = stage;
-      hpc_opt.output = fs::absolute(output.empty() ? fs::path("runs") / cfg.name : fs::path(output));
-      check_output_path(hpc_opt.output);
-      check_run_folder(cfg, hpc_opt.output, force);
-      hpc_opt.np = np;  // 0: not given; the stages' resources decide
-      const auto n_tasks = [&](const std::string& s) {
-        Invocation inv;
-        inv.stages = {s};
-        inv.opts.output = hpc_opt.output;
-        return count_tasks(cfg, inv);
-      };
-      out << write_hpc_scripts(cfg, hpc_opt, n_tasks, fs::canonical("/proc/self/exe").string());
-      return 0;
-    }
-    if (check) {
+    if (*impact) return impact_command(a, out);
+    if (*compare) return compare_command(a, out);
+    const auto cfg = config::load_case(a.case_file, project_dir());
+    if (*hpc) return hpc_command(cfg, a, out);
+    if (a.check) {
       out << fmt::format("{}: case '{}' is valid; ore card {} ({})\n", cfg.file.string(), cfg.name,
                          cfg.ore_file.string(), cfg.ore.str("name"));
       return 0;
     }
-    if (stage.empty()) {
-      err << "error: --stage: which stage? expected one of flow, sample, transport, calibrate, breakage, report, all\n"
-          << "Run 'orchestrate --help' for examples.\n";
-      return kExitBadInput;
-    }
-    Invocation inv;
-    inv.stages = resolve_stages(stage);
-    // Absolute: engines and helper scripts run in other working directories.
-    inv.opts.output = fs::absolute(output.empty() ? fs::path("runs") / cfg.name : fs::path(output));
-    check_output_path(inv.opts.output);
-    check_run_folder(cfg, inv.opts.output, force);
-    inv.opts.np = np > 0 ? np : static_cast<int>(cfg.doc.integer("resources.np"));
-    inv.opts.jobs = jobs > 0 ? jobs : static_cast<int>(cfg.doc.integer("resources.jobs"));
-    inv.opts.force = force;
-    if (const char* job = std::getenv("MILL_SCHEDULER_JOB")) inv.opts.scheduler_job = job;
-    if (const char* log = std::getenv("MILL_SCHEDULER_LOG")) inv.opts.scheduler_log = log;
-    inv.dry_run = dry_run;
-    inv.list_tasks = list_tasks;
-    inv.merge_only = merge_only;
-    if (task >= 0) inv.task = task;
-    return run_pipeline(cfg, inv, out);
-  } catch (const config::ConfigError& e) {
-    err << "error: " << e.what() << "\n";
-    return kExitBadInput;
-  } catch (const NotImplemented& e) {
-    err << "error: " << e.what() << "\n";
-    return kExitNotImplemented;
-  } catch (const MissingInput& e) {
-    err << "error: " << e.what() << "\n";
-    return kExitFailed;
-  } catch (const fs::filesystem_error& e) {
-    // A file operation the user's paths or disk made fail: name the path.
-    err << "error: " << (e.path1().empty() ? std::string("a file operation") : e.path1().string()) << ": "
-        << e.code().message() << (e.path2().empty() ? "" : " (with " + e.path2().string() + ")")
-        << "\nCheck that the run folder (--output) is a writable directory with free space.\n";
-    return kExitFailed;
-  } catch (const engine::Interrupted& e) {
-    err << "orchestrate: " << e.what() << "; finished jobs are kept, rerun the same command to resume\n";
-    return 128 + e.signal;
-  } catch (const std::exception& e) {
-    err << "error: " << e.what() << "\n";
-    return kExitFailed;
+    return stage_command(cfg, a, out, err);
+  } catch (...) {
+    return error_status(err);
   }
 }
 

@@ -75,16 +75,14 @@ std::string write_compare(const CompareOptions& opt) {
   fs::create_directories(opt.output / "figures");
   const fs::path png = opt.output / "figures" / "compare_passing.png";
   fs::remove(png);
-  engine::Command c;
-  c.argv = {"/usr/bin/python3", (opt.project_dir / "postprocess" / "plot_compare.py").string(), "--out", png.string()};
+  std::vector<std::string> args = {"--out", png.string()};
   for (size_t i = 0; i < opt.runs.size(); ++i) {
-    c.argv.push_back("--run");
-    c.argv.push_back(labels[i] + "=" + fs::absolute(opt.runs[i]).string());
+    args.push_back("--run");
+    args.push_back(labels[i] + "=" + fs::absolute(opt.runs[i]).string());
   }
-  c.cwd = opt.output;
-  c.log = opt.output / "plot_compare.log";
-  c.job = "compare/plot";
-  engine::Runner().run(c);
+  engine::Runner runner;
+  engine::run_python(runner, opt.project_dir / "postprocess" / "plot_compare.py", args,
+                     opt.output / "plot_compare.log", "compare/plot");
 
   using report::esc;
   std::ostringstream o;

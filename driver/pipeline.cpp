@@ -3,23 +3,23 @@
 
 #include <fmt/format.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <mutex>
 #include <sstream>
 #include <thread>
 
-#include <yaml-cpp/yaml.h>
-
 #include "engine/runner.h"
 #include "jobs/job_store.h"
 #include "progress.h"
-#include "stages/breakage_stage.h"
+#include "stages/breakage/impact_runs.h"
 
 namespace mill {
 namespace fs = std::filesystem;
@@ -36,9 +36,10 @@ size_t stage_index(const std::string& stage, const std::string& given) {
   size_t best = 99;
   for (const auto& n : names)
     if (config::edit_distance(stage, n) < best) best = config::edit_distance(stage, n), hint = n;
-  throw config::ConfigError(fmt::format("--stage: expected one of {}all or a range FIRST-LAST (e.g. transport-breakage), "
-                                        "got '{}'{}",
-                                        list, given, best <= 2 ? "; did you mean '" + hint + "'?" : ""));
+  throw config::ConfigError(
+      fmt::format("--stage: expected one of {}all or a range FIRST-LAST (e.g. transport-breakage), "
+                  "got '{}'{}",
+                  list, given, best <= 2 ? "; did you mean '" + hint + "'?" : ""));
 }
 }  // namespace
 
@@ -48,11 +49,13 @@ std::vector<std::string> resolve_stages(const std::string& stage) {
   const size_t dash = stage.find('-');
   if (dash == std::string::npos) return {names[stage_index(stage, stage)]};
   // A range FIRST-LAST: every stage from FIRST to LAST in pipeline order.
-  const size_t first = stage_index(stage.substr(0, dash), stage), last = stage_index(stage.substr(dash + 1), stage);
+  const size_t first = stage_index(stage.substr(0, dash), stage),
+               last = stage_index(stage.substr(dash + 1), stage);
   if (first > last)
-    throw config::ConfigError(fmt::format("--stage {}: '{}' comes after '{}' in the pipeline; expected FIRST-LAST in "
-                                          "pipeline order, e.g. {}-{}",
-                                          stage, names[first], names[last], names[last], names[first]));
+    throw config::ConfigError(
+        fmt::format("--stage {}: '{}' comes after '{}' in the pipeline; expected FIRST-LAST in "
+                    "pipeline order, e.g. {}-{}",
+                    stage, names[first], names[last], names[last], names[first]));
   return {names.begin() + static_cast<long>(first), names.begin() + static_cast<long>(last) + 1};
 }
 
@@ -65,8 +68,8 @@ struct JobRow {
 
 // Per job: run, skip or busy. A job marked done whose declared outputs are
 // missing or damaged is run again, and the reason says which file.
-std::vector<JobRow> decide_all(const Stage& stage, const StageContext& ctx, const jobs::JobStore& store,
-                               const Plan& plan, bool force) {
+std::vector<JobRow> decide_all(const Stage& stage, const StageContext& ctx,
+                               const jobs::JobStore& store, const Plan& plan, bool force) {
   std::vector<JobRow> rows;
   for (const auto& j : plan.jobs) {
     jobs::Verdict v = store.decide(j.label, j.inputs, force);
@@ -85,10 +88,13 @@ void check_unique_labels(const std::string& stage, const Plan& plan) {
   for (size_t i = 0; i < plan.jobs.size(); ++i) {
     const auto [it, fresh] = seen.emplace(plan.jobs[i].label, i);
     if (!fresh)
-      throw config::ConfigError(fmt::format(
-          "stage {}: jobs {} ({}) and {} ({}) have the same label '{}': their conditions are equal or differ past the "
-          "label's precision; give each condition once, with values that differ in the first 6 digits",
-          stage, it->second, plan.jobs[it->second].summary, i, plan.jobs[i].summary, plan.jobs[i].label));
+      throw config::ConfigError(
+          fmt::format("stage {}: jobs {} ({}) and {} ({}) have the same label '{}': their "
+                      "conditions are equal or differ past the "
+                      "label's precision; give each condition once, with values that differ in the "
+                      "first 6 digits",
+                      stage, it->second, plan.jobs[it->second].summary, i, plan.jobs[i].summary,
+                      plan.jobs[i].label));
   }
 }
 
@@ -108,15 +114,18 @@ void write_provenance(const config::CaseConfig& cfg, const fs::path& run_dir) {
   };
   copy(cfg.file, run_dir / "case.yaml");
   copy(cfg.ore_file, run_dir / "ore.yaml");
-  nlohmann::json j = {{"case_file", cfg.file.string()},   {"ore_card", cfg.ore_file.string()},
-                      {"case", cfg.doc.to_json()},         {"ore", cfg.ore.to_json()},
+  nlohmann::json j = {{"case_file", cfg.file.string()},
+                      {"ore_card", cfg.ore_file.string()},
+                      {"case", cfg.doc.to_json()},
+                      {"ore", cfg.ore.to_json()},
                       {"orchestrate_version", MILL_VERSION}};
   j["case_name"] = cfg.name;
   jobs::atomic_write(run_dir / "resolved_case.json", j.dump(2) + "\n");
 }
 
 // Run one job with its STATUS bookkeeping. Returns "" on success, else the reason.
-std::string run_one(Stage& stage, StageContext& ctx, const jobs::JobStore& store, const JobSpec& job) {
+std::string run_one(Stage& stage, StageContext& ctx, const jobs::JobStore& store,
+                    const JobSpec& job) {
   store.mark_running(job.label, job.inputs, ctx.opts.scheduler_job, ctx.opts.scheduler_log);
   const auto t0 = std::chrono::steady_clock::now();
   ctx.progress.job_begin(job.label);
@@ -149,17 +158,210 @@ std::string not_done_text(const jobs::JobStore& store, const JobRow& r) {
   const jobs::Status s = store.read_status(r.spec.label);
   std::string why;
   switch (s.state) {
-    case jobs::State::None: why = "not run: no STATUS (its task did not start, or failed before the job did)"; break;
-    case jobs::State::Running:
-      why = fmt::format("did not finish: STATUS still says running as pid {} on {} (killed, e.g. at the time limit?)",
-                        s.pid, s.host);
+    case jobs::State::None:
+      why = "not run: no STATUS (its task did not start, or failed before the job did)";
       break;
-    case jobs::State::Failed: why = "failed: " + s.reason; break;
-    default: why = r.verdict.why; break;
+    case jobs::State::Running:
+      why = fmt::format(
+          "did not finish: STATUS still says running as pid {} on {} (killed, e.g. at the time "
+          "limit?)",
+          s.pid, s.host);
+      break;
+    case jobs::State::Failed:
+      why = "failed: " + s.reason;
+      break;
+    default:
+      why = r.verdict.why;
+      break;
   }
   if (!s.scheduler_job.empty()) why += fmt::format("; scheduler job {}", s.scheduler_job);
   if (!s.log.empty()) why += fmt::format(", log {}", s.log);
   return why;
+}
+
+// The stage called `name` (one of make_stages()).
+Stage& find_stage(const std::vector<std::unique_ptr<Stage>>& stages, const std::string& name) {
+  const auto it =
+      std::find_if(stages.begin(), stages.end(), [&](const auto& s) { return s->name() == name; });
+  return **it;
+}
+
+// The options that exclude each other: --task with --merge-only or several stages.
+void check_invocation(const Invocation& inv) {
+  if (inv.task && inv.merge_only)
+    throw config::ConfigError("--merge-only: runs no job, so it takes no --task");
+  if (inv.task && inv.stages.size() != 1)
+    throw config::ConfigError(
+        "--task: needs exactly one --stage (the stage whose job list --list-tasks shows), not "
+        "'all'");
+}
+
+// --task names a job of the stage's plan.
+void check_task_index(const Invocation& inv, const std::string& name, const Plan& plan) {
+  if (inv.task && (*inv.task < 0 || *inv.task >= static_cast<int>(plan.jobs.size())))
+    throw config::ConfigError(
+        plan.jobs.empty()
+            ? fmt::format("--task: stage '{}' has no jobs yet{}, got --task {}", name,
+                          plan.note.empty() ? "" : " (" + plan.note + ")", *inv.task)
+            : fmt::format("--task: expected an index in [0, {}] for stage '{}' ({} job{}), got {}",
+                          plan.jobs.size() - 1, name, plan.jobs.size(),
+                          plan.jobs.size() == 1 ? "" : "s", *inv.task));
+}
+
+// --list-tasks: one job per line (index, label, state, summary).
+void print_tasks(std::ostream& out, const std::string& name, const Plan& plan,
+                 const std::vector<JobRow>& rows) {
+  for (size_t i = 0; i < rows.size(); ++i)
+    out << fmt::format("{}\t{}\t{}\t{}\n", i, rows[i].spec.label, verdict_tag(rows[i].verdict),
+                       rows[i].spec.summary);
+  if (rows.empty() && !plan.note.empty())
+    out << "# " << name << ": no tasks yet: " << plan.note << "\n";
+}
+
+// --dry-run: the stage, its jobs, which are done and their ids.
+void print_plan(std::ostream& out, const Stage& stage, const Plan& plan,
+                const std::vector<JobRow>& rows) {
+  const int n_done = static_cast<int>(std::count_if(rows.begin(), rows.end(), [](const JobRow& r) {
+    return r.verdict.decision == jobs::Decision::Skip;
+  }));
+  out << fmt::format("stage {} - {}{}\n  {} job{}, {} done, {} to run\n", stage.name(),
+                     stage.description(), stage.implemented() ? "" : " [not implemented yet]",
+                     rows.size(), rows.size() == 1 ? "" : "s", n_done, rows.size() - n_done);
+  if (!plan.note.empty()) out << "  note: " << plan.note << "\n";
+  for (size_t i = 0; i < rows.size(); ++i)
+    out << fmt::format("  [{}] {:>3} {:<22} {} ({}, id {})\n", verdict_tag(rows[i].verdict), i,
+                       rows[i].spec.label, rows[i].spec.summary, rows[i].verdict.why,
+                       jobs::job_id(rows[i].spec.inputs));
+}
+
+// What one pass over a stage shares: the stage, its context and job store,
+// its plan and the verdict per job.
+struct StagePass {
+  Stage& stage;
+  StageContext& ctx;
+  const jobs::JobStore& store;
+  const Plan& plan;
+  const std::vector<JobRow>& rows;
+};
+
+// --merge-only, after a scheduler ran the jobs: merge only when every job is
+// done (calling `before_merge` first); else name each job that is not and
+// return kExitFailed.
+int merge_stage(const StagePass& p, std::ostream& out, const std::function<void()>& before_merge) {
+  const std::string name = p.stage.name();
+  std::vector<std::string> missing;
+  for (size_t i = 0; i < p.rows.size(); ++i)
+    if (p.rows[i].verdict.decision != jobs::Decision::Skip)
+      missing.push_back(fmt::format("{}/{} (task {}): {}", name, p.rows[i].spec.label, i,
+                                    not_done_text(p.store, p.rows[i])));
+  if (p.rows.empty() && !p.plan.note.empty())
+    missing.push_back(fmt::format("{}: no jobs: {}", name, p.plan.note));
+  for (const auto& m : missing) out << "error: " << m << "\n";
+  if (!missing.empty()) {
+    out << fmt::format("stage '{}': {} of {} job(s) not done; nothing merged.\n", name,
+                       missing.size(), p.rows.size());
+    return kExitFailed;
+  }
+  before_merge();
+  p.stage.finalize(p.ctx, p.plan.jobs);
+  out << fmt::format("stage '{}': all {} job(s) done; merged.\n", name, p.rows.size());
+  return kExitOk;
+}
+
+// MPI ranks that wait for each other on shared cores burn CPU in the
+// wait: 2 jobs x 2 ranks on 2 cores cost ~3x the CPU of 1 rank per job.
+void warn_oversubscribed(std::ostream& out, int n_threads, int np) {
+  const unsigned cores = std::thread::hardware_concurrency();
+  if (n_threads > 1 && cores > 0 && static_cast<unsigned>(n_threads * np) > cores)
+    out << fmt::format(
+        "warning: {} jobs x {} MPI ranks = {} processes on {} cores: oversubscribed, every run "
+        "slows "
+        "down; prefer --np 1 --jobs {} here (resources.np / resources.jobs)\n",
+        n_threads, np, n_threads * np, cores, cores);
+}
+
+// The jobs of a pass that failed (with the reason) or were busy elsewhere.
+struct PoolOutcome {
+  std::vector<std::string> failures, busy;
+};
+
+// Runs the jobs of `todo` that are to run, on n_threads threads; the first
+// fatal error (interrupt, not implemented) stops the pool and is rethrown.
+PoolOutcome run_pool(const StagePass& p, const std::vector<JobRow>& todo, int n_threads) {
+  const std::string name = p.stage.name();
+  PoolOutcome res;
+  std::mutex mu;
+  std::atomic<size_t> next{0};
+  std::exception_ptr fatal;
+  auto worker = [&]() {
+    for (;;) {
+      const size_t i = next.fetch_add(1);
+      if (i >= todo.size()) return;
+      const JobRow& r = todo[i];
+      if (r.verdict.decision == jobs::Decision::Skip) continue;
+      if (r.verdict.decision == jobs::Decision::Busy) {
+        std::lock_guard<std::mutex> g(mu);
+        res.busy.push_back(r.spec.label + ": " + r.verdict.why);
+        continue;
+      }
+      {
+        std::lock_guard<std::mutex> g(mu);
+        if (fatal) return;
+      }
+      if (r.verdict.why != "new")
+        p.ctx.progress.info(fmt::format("[{}] rerun {}: {}", name, r.spec.label, r.verdict.why));
+      try {
+        const std::string reason = run_one(p.stage, p.ctx, p.store, r.spec);
+        if (!reason.empty()) {
+          std::lock_guard<std::mutex> g(mu);
+          res.failures.push_back(fmt::format("{}/{}: {}", name, r.spec.label, reason));
+        }
+      } catch (...) {
+        std::lock_guard<std::mutex> g(mu);
+        if (!fatal) fatal = std::current_exception();
+        return;
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 0; t < n_threads; ++t) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+  p.ctx.progress.stage_end();
+  if (fatal) std::rethrow_exception(fatal);
+  return res;
+}
+
+// Runs the stage's jobs (only job --task with --task), reports failed and
+// busy jobs, and merges the stage when all are done (not after one --task).
+int run_stage(const StagePass& p, const Invocation& inv, std::ostream& out) {
+  const std::string name = p.stage.name();
+  std::vector<JobRow> todo;
+  if (inv.task) {
+    todo.push_back(p.rows[*inv.task]);
+  } else {
+    todo = p.rows;
+  }
+  p.ctx.progress.stage_begin(
+      name, static_cast<int>(todo.size()),
+      static_cast<int>(std::count_if(todo.begin(), todo.end(), [](const JobRow& r) {
+        return r.verdict.decision == jobs::Decision::Skip;
+      })));
+  const int n_threads = std::max(1, std::min<int>(inv.opts.jobs, static_cast<int>(todo.size())));
+  warn_oversubscribed(out, n_threads, inv.opts.np);
+  const PoolOutcome res = run_pool(p, todo, n_threads);
+  for (const auto& f : res.failures) out << "error: " << f << "\n";
+  for (const auto& b : res.busy) out << "warning: not run, " << b << "\n";
+  if (!res.failures.empty()) {
+    out << fmt::format(
+        "stage '{}': {} job(s) failed; fix the cause and rerun the same command: done jobs are "
+        "kept.\n",
+        name, res.failures.size());
+    return kExitFailed;
+  }
+  if (!res.busy.empty()) return kExitFailed;
+  // A single array task does not merge; the follow-up (whole stage) run does.
+  if (!inv.task) p.stage.finalize(p.ctx, p.plan.jobs);
+  return kExitOk;
 }
 
 }  // namespace
@@ -169,151 +371,52 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
   engine::Runner runner;
   Progress progress(out, isatty(STDOUT_FILENO) && &out == &std::cout);
   const fs::path run_dir = inv.opts.output;
-
-  if (inv.task && inv.merge_only)
-    throw config::ConfigError("--merge-only: runs no job, so it takes no --task");
-  if (inv.task && inv.stages.size() != 1)
-    throw config::ConfigError("--task: needs exactly one --stage (the stage whose job list --list-tasks shows), not 'all'");
+  check_invocation(inv);
   bool provenance_written = false;
+  // A copy of what was run, written once before the first job or merge.
+  const std::function<void()> provenance = [&]() {
+    if (!provenance_written) write_provenance(cfg, run_dir), provenance_written = true;
+  };
 
   if (inv.dry_run)
-    out << fmt::format("plan for case '{}' ({}), output {}\n", cfg.name, cfg.file.string(), run_dir.string());
+    out << fmt::format("plan for case '{}' ({}), output {}\n", cfg.name, cfg.file.string(),
+                       run_dir.string());
   // Every stage's plan as far as it is known now, before any stage runs: a
   // label clash in a late stage must not surface after hours of earlier ones.
   for (const auto& name : inv.stages) {
-    auto it = std::find_if(stages.begin(), stages.end(), [&](const auto& s) { return s->name() == name; });
     StageContext ctx{cfg, inv.opts, run_dir, run_dir / name, runner, progress};
-    check_unique_labels(name, (*it)->plan(ctx));
+    check_unique_labels(name, find_stage(stages, name).plan(ctx));
   }
 
   for (const auto& name : inv.stages) {
-    auto it = std::find_if(stages.begin(), stages.end(), [&](const auto& s) { return s->name() == name; });
-    Stage& stage = **it;
+    Stage& stage = find_stage(stages, name);
     StageContext ctx{cfg, inv.opts, run_dir, run_dir / name, runner, progress};
     const jobs::JobStore store(ctx.stage_dir);
     const Plan plan = stage.plan(ctx);
     check_unique_labels(name, plan);
-    if (inv.task && (*inv.task < 0 || *inv.task >= static_cast<int>(plan.jobs.size())))
-      throw config::ConfigError(
-          plan.jobs.empty()
-              ? fmt::format("--task: stage '{}' has no jobs yet{}, got --task {}", name,
-                            plan.note.empty() ? "" : " (" + plan.note + ")", *inv.task)
-              : fmt::format("--task: expected an index in [0, {}] for stage '{}' ({} job{}), got {}",
-                            plan.jobs.size() - 1, name, plan.jobs.size(), plan.jobs.size() == 1 ? "" : "s", *inv.task));
+    check_task_index(inv, name, plan);
     const auto rows = decide_all(stage, ctx, store, plan, inv.opts.force);
-    const int n_done = static_cast<int>(std::count_if(rows.begin(), rows.end(), [](const JobRow& r) {
-      return r.verdict.decision == jobs::Decision::Skip;
-    }));
-
+    const StagePass pass{stage, ctx, store, plan, rows};
     if (inv.list_tasks) {
-      for (size_t i = 0; i < rows.size(); ++i)
-        out << fmt::format("{}\t{}\t{}\t{}\n", i, rows[i].spec.label, verdict_tag(rows[i].verdict), rows[i].spec.summary);
-      if (rows.empty() && !plan.note.empty()) out << "# " << name << ": no tasks yet: " << plan.note << "\n";
+      print_tasks(out, name, plan, rows);
       continue;
     }
     if (inv.dry_run) {
-      out << fmt::format("stage {} - {}{}\n  {} job{}, {} done, {} to run\n", name, stage.description(),
-                         stage.implemented() ? "" : " [not implemented yet]", rows.size(), rows.size() == 1 ? "" : "s",
-                         n_done, rows.size() - n_done);
-      if (!plan.note.empty()) out << "  note: " << plan.note << "\n";
-      for (size_t i = 0; i < rows.size(); ++i)
-        out << fmt::format("  [{}] {:>3} {:<22} {} ({}, id {})\n", verdict_tag(rows[i].verdict), i, rows[i].spec.label,
-                           rows[i].spec.summary, rows[i].verdict.why, jobs::job_id(rows[i].spec.inputs));
+      print_plan(out, stage, plan, rows);
       continue;
     }
-
     if (inv.merge_only) {
-      // After a scheduler ran the jobs: merge only when every job is done.
-      std::vector<std::string> missing;
-      for (size_t i = 0; i < rows.size(); ++i)
-        if (rows[i].verdict.decision != jobs::Decision::Skip)
-          missing.push_back(fmt::format("{}/{} (task {}): {}", name, rows[i].spec.label, i, not_done_text(store, rows[i])));
-      if (rows.empty() && !plan.note.empty()) missing.push_back(fmt::format("{}: no jobs: {}", name, plan.note));
-      for (const auto& m : missing) out << "error: " << m << "\n";
-      if (!missing.empty()) {
-        out << fmt::format("stage '{}': {} of {} job(s) not done; nothing merged.\n", name, missing.size(), rows.size());
-        return kExitFailed;
-      }
-      if (!provenance_written) write_provenance(cfg, run_dir), provenance_written = true;
-      stage.finalize(ctx, plan.jobs);
-      out << fmt::format("stage '{}': all {} job(s) done; merged.\n", name, rows.size());
+      if (merge_stage(pass, out, provenance) != kExitOk) return kExitFailed;
       continue;
-    }
-
-    std::vector<JobRow> todo;
-    if (inv.task) {
-      todo.push_back(rows[*inv.task]);
-    } else {
-      todo = rows;
     }
     if (!stage.implemented()) {
-      out << fmt::format("stage '{}' ({}) is not implemented yet: nothing was run and no output was written.\n", name,
-                         stage.description());
+      out << fmt::format(
+          "stage '{}' ({}) is not implemented yet: nothing was run and no output was written.\n",
+          name, stage.description());
       return kExitNotImplemented;
     }
-
-    if (!provenance_written) write_provenance(cfg, run_dir), provenance_written = true;
-    progress.stage_begin(name, static_cast<int>(todo.size()),
-                         static_cast<int>(std::count_if(todo.begin(), todo.end(), [](const JobRow& r) {
-                           return r.verdict.decision == jobs::Decision::Skip;
-                         })));
-    std::vector<std::string> failures, busy;
-    std::mutex mu;
-    std::atomic<size_t> next{0};
-    std::exception_ptr fatal;
-    auto worker = [&]() {
-      for (;;) {
-        const size_t i = next.fetch_add(1);
-        if (i >= todo.size()) return;
-        const JobRow& r = todo[i];
-        if (r.verdict.decision == jobs::Decision::Skip) continue;
-        if (r.verdict.decision == jobs::Decision::Busy) {
-          std::lock_guard<std::mutex> g(mu);
-          busy.push_back(r.spec.label + ": " + r.verdict.why);
-          continue;
-        }
-        {
-          std::lock_guard<std::mutex> g(mu);
-          if (fatal) return;
-        }
-        if (r.verdict.why != "new") progress.info(fmt::format("[{}] rerun {}: {}", name, r.spec.label, r.verdict.why));
-        try {
-          const std::string reason = run_one(stage, ctx, store, r.spec);
-          if (!reason.empty()) {
-            std::lock_guard<std::mutex> g(mu);
-            failures.push_back(fmt::format("{}/{}: {}", name, r.spec.label, reason));
-          }
-        } catch (...) {
-          std::lock_guard<std::mutex> g(mu);
-          if (!fatal) fatal = std::current_exception();
-          return;
-        }
-      }
-    };
-    const int n_threads = std::max(1, std::min<int>(inv.opts.jobs, static_cast<int>(todo.size())));
-    // MPI ranks that wait for each other on shared cores burn CPU in the
-    // wait: 2 jobs x 2 ranks on 2 cores cost ~3x the CPU of 1 rank per job.
-    const unsigned cores = std::thread::hardware_concurrency();
-    if (n_threads > 1 && cores > 0 && static_cast<unsigned>(n_threads * inv.opts.np) > cores)
-      out << fmt::format("warning: {} jobs x {} MPI ranks = {} processes on {} cores: oversubscribed, every run slows "
-                         "down; prefer --np 1 --jobs {} here (resources.np / resources.jobs)\n",
-                         n_threads, inv.opts.np, n_threads * inv.opts.np, cores, cores);
-    std::vector<std::thread> pool;
-    for (int t = 0; t < n_threads; ++t) pool.emplace_back(worker);
-    for (auto& t : pool) t.join();
-    progress.stage_end();
-    if (fatal) std::rethrow_exception(fatal);
-
-    for (const auto& f : failures) out << "error: " << f << "\n";
-    for (const auto& b : busy) out << "warning: not run, " << b << "\n";
-    if (!failures.empty()) {
-      out << fmt::format("stage '{}': {} job(s) failed; fix the cause and rerun the same command: done jobs are kept.\n",
-                         name, failures.size());
-      return kExitFailed;
-    }
-    if (!busy.empty()) return kExitFailed;
-    // A single array task does not merge; the follow-up (whole stage) run does.
-    if (!inv.task) stage.finalize(ctx, plan.jobs);
+    provenance();
+    if (const int status = run_stage(pass, inv, out); status != kExitOk) return status;
   }
   return kExitOk;
 }
@@ -327,14 +430,18 @@ void check_run_folder(const config::CaseConfig& cfg, const fs::path& run_dir, bo
     std::ifstream in(resolved);
     const auto j = nlohmann::json::parse(in, nullptr, false);
     if (!j.is_object())
-      throw config::ConfigError(fmt::format("--output {}: {} is damaged (not a JSON object), so the folder's case is "
-                                            "unknown; use another --output, or --force to take the folder over",
-                                            run_dir.string(), resolved.string()));
+      throw config::ConfigError(
+          fmt::format("--output {}: {} is damaged (not a JSON object), so the folder's case is "
+                      "unknown; use another --output, or --force to take the folder over",
+                      run_dir.string(), resolved.string()));
     owner_file = j.value("case_file", std::string());
-    if (j.contains("case_name") && j["case_name"].is_string()) owner = j["case_name"].get<std::string>();
-    else if (j.contains("case") && j["case"].is_object() && j["case"].contains("name") && j["case"]["name"].is_string())
+    if (j.contains("case_name") && j["case_name"].is_string())
+      owner = j["case_name"].get<std::string>();
+    else if (j.contains("case") && j["case"].is_object() && j["case"].contains("name") &&
+             j["case"]["name"].is_string())
       owner = j["case"]["name"].get<std::string>();
-    else if (!owner_file.empty()) owner = fs::path(owner_file).stem().string();
+    else if (!owner_file.empty())
+      owner = fs::path(owner_file).stem().string();
   } else if (fs::exists(copy, ec)) {
     try {
       const YAML::Node n = YAML::LoadFile(copy.string());
@@ -343,11 +450,12 @@ void check_run_folder(const config::CaseConfig& cfg, const fs::path& run_dir, bo
     }
   }
   if (owner.empty() || owner == cfg.name) return;
-  throw config::ConfigError(fmt::format(
-      "--output {}: the run folder belongs to case '{}'{}; this is case '{}' ({}): use another --output (the default "
-      "is runs/{}), or --force to take the folder over (every job is then redone)",
-      run_dir.string(), owner, owner_file.empty() ? "" : " (" + owner_file + ")", cfg.name, cfg.file.string(),
-      cfg.name));
+  throw config::ConfigError(
+      fmt::format("--output {}: the run folder belongs to case '{}'{}; this is case '{}' ({}): use "
+                  "another --output (the default "
+                  "is runs/{}), or --force to take the folder over (every job is then redone)",
+                  run_dir.string(), owner, owner_file.empty() ? "" : " (" + owner_file + ")",
+                  cfg.name, cfg.file.string(), cfg.name));
 }
 
 int count_tasks(const config::CaseConfig& cfg, const Invocation& inv) {
@@ -357,43 +465,45 @@ int count_tasks(const config::CaseConfig& cfg, const Invocation& inv) {
   Progress progress(sink, false);
   for (auto& s : stages)
     if (s->name() == inv.stages.at(0)) {
-      StageContext ctx{cfg, inv.opts, inv.opts.output, inv.opts.output / s->name(), runner, progress};
+      StageContext ctx{cfg,    inv.opts, inv.opts.output, inv.opts.output / s->name(),
+                       runner, progress};
       return static_cast<int>(s->plan(ctx).jobs.size());
     }
   return 0;
 }
 
-int run_single_impact(const config::CaseConfig& cfg, const RunOptions& opts, double velocity, double angle,
-                      int repeat, std::ostream& out) {
+int run_single_impact(const config::CaseConfig& cfg, const RunOptions& opts, double velocity,
+                      double angle, int repeat, std::ostream& out) {
   engine::Runner runner;
   Progress progress(out, isatty(STDOUT_FILENO) && &out == &std::cout);
   StageContext ctx{cfg, opts, opts.output, opts.output / "breakage", runner, progress};
   const std::string label = fmt::format("impact_v{:g}_a{:g}_r{}", velocity, angle, repeat);
   // The output folder is the job's folder: an identical rerun is skipped.
   const jobs::JobStore store = jobs::JobStore::single(opts.output);
-  const nlohmann::json inputs = impact_inputs(ctx, velocity, angle, repeat);
+  const nlohmann::json inputs = breakage::impact_inputs(ctx, velocity, angle, repeat);
   jobs::Verdict v = store.decide(label, inputs, opts.force);
   if (v.decision == jobs::Decision::Skip)
-    if (const std::string why = damaged_impact_outputs(opts.output); !why.empty())
+    if (const std::string why = breakage::damaged_impact_outputs(opts.output); !why.empty())
       v = {jobs::Decision::Run, "done before, but an output is damaged: " + why};
   if (v.decision == jobs::Decision::Busy)
     throw std::runtime_error(fmt::format("impact into {}: {}", opts.output.string(), v.why));
   if (v.decision == jobs::Decision::Skip) {
     std::ifstream in(opts.output / "result.json");
-    out << impact_line(nlohmann::json::parse(in, nullptr, false)) << "\n"
-        << "already done with the same inputs (job " << jobs::job_id(inputs) << "): " << opts.output.string()
-        << "; --force redoes it\n";
+    out << breakage::impact_line(nlohmann::json::parse(in, nullptr, false)) << "\n"
+        << "already done with the same inputs (job " << jobs::job_id(inputs)
+        << "): " << opts.output.string() << "; --force redoes it\n";
     return kExitOk;
   }
   write_provenance(cfg, opts.output);
   if (v.why != "new") progress.info(fmt::format("impact: rerun: {}", v.why));
-  progress.info(fmt::format("impact: {}-element lump of {} at {:g} m/s, {:g} deg, into {}", cfg.doc.integer("lump.n_elements"),
-                            cfg.ore.str("name"), velocity, angle, opts.output.string()));
+  progress.info(fmt::format("impact: {}-element lump of {} at {:g} m/s, {:g} deg, into {}",
+                            cfg.doc.integer("lump.n_elements"), cfg.ore.str("name"), velocity,
+                            angle, opts.output.string()));
   progress.stage_begin("impact", 1, 0);
   store.mark_running(label, inputs);
   std::string line;
   try {
-    line = run_impact(ctx, velocity, angle, repeat, opts.output, label);
+    line = breakage::run_impact(ctx, velocity, angle, repeat, opts.output, label);
   } catch (const std::exception& e) {
     const std::string why = e.what();
     store.mark_failed(label, why.substr(0, why.find('\n')));
@@ -402,7 +512,8 @@ int run_single_impact(const config::CaseConfig& cfg, const RunOptions& opts, dou
   store.mark_done(label);
   progress.stage_end();
   out << line << "\n"
-      << "written: " << (opts.output / "summary.csv").string() << ", fractions.csv, impact.h5, fragments.vtp, result.json\n";
+      << "written: " << (opts.output / "summary.csv").string()
+      << ", fractions.csv, impact.h5, fragments.vtp, result.json\n";
   return kExitOk;
 }
 

@@ -346,6 +346,15 @@ nlohmann::json Document::to_json() const {
   return j;
 }
 
+nlohmann::json ore_keys(const Document& ore) {
+  nlohmann::json all = ore.to_json(), out = nlohmann::json::object();
+  for (auto it = all.begin(); it != all.end(); ++it)
+    if (it.key() != "name" && it.key() != "source" && it.key().rfind("calibrated.", 0) != 0 &&
+        it.key().rfind("jk.", 0) != 0)
+      out[it.key()] = it.value();
+  return out;
+}
+
 void check_ore(const Document& ore) {
   if (ore.real("ucs") <= ore.real("tensile_strength"))
     throw ConfigError(fmt::format("{}: expected ucs > tensile_strength (rocks: ucs/tensile ~ 5-20), got ucs {:g} Pa <= {:g} Pa",

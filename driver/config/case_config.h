@@ -71,6 +71,10 @@ CaseConfig load_case(const std::filesystem::path& file, const std::filesystem::p
 // or another non-regular file, or unreadable.
 std::string read_regular_file(const std::filesystem::path& file, const std::string& what);
 
+// The ore card's macro properties (everything but name, source, calibrated.*
+// and jk.*), as canonical JSON: what job ids hash and a calibration is fitted to.
+nlohmann::json ore_keys(const Document& ore);
+
 // Physical consistency of an ore card (UCS > tensile strength, ...).
 void check_ore(const Document& ore);
 

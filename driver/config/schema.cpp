@@ -101,154 +101,262 @@ std::vector<KeyDef> stage_resources(const std::string& stage, const std::string&
 
 using T = KeyType;
 
-Schema make_case_schema() {
-  Schema s;
-  s.what = "case file";
-  s.keys = {
+// The case itself, the mill geometry and the rotor speeds.
+std::vector<KeyDef> mill_keys() {
+  return {
       opt(key("name", T::String, "", "", "Case name; default: the case file's name without .yaml")),
       opt(key("description", T::String, "", "", "Free text shown in the report")),
 
       // --- mill geometry (shared by OpenFOAM and LIGGGHTS through STL) ---
       positive(key("mill.housing.height", T::Real, "m", "4.0", "Housing height (y, vertical)")),
       positive(key("mill.housing.width", T::Real, "m", "1.6", "Housing width (x)")),
-      positive(key("mill.housing.depth", T::Real, "m", "0.5", "Housing depth (z, along the rotor axis)")),
-      positive(key("mill.flywheel.diameter", T::Real, "m", "1.0", "Flywheel tip diameter (beater plate tips)")),
-      positive(key("mill.flywheel.hub_diameter", T::Real, "m", "0.3", "Hub (disc) diameter carrying the plates")),
+      positive(key("mill.housing.depth", T::Real, "m", "0.5",
+                   "Housing depth (z, along the rotor axis)")),
+      positive(key("mill.flywheel.diameter", T::Real, "m", "1.0",
+                   "Flywheel tip diameter (beater plate tips)")),
+      positive(key("mill.flywheel.hub_diameter", T::Real, "m", "0.3",
+                   "Hub (disc) diameter carrying the plates")),
       at_least(key("mill.flywheel.n_plates", T::Int, "", "6", "Number of flat beater plates"), 1),
-      positive(key("mill.flywheel.plate_width", T::Real, "m", "0.3", "Beater plate width along the axis")),
-      positive(key("mill.flywheel.plate_thickness", T::Real, "m", "0.02", "Beater plate thickness")),
-      positive(key("mill.flywheel.axis_height", T::Real, "m", "1.2", "Height of the rotor axis above the housing floor")),
-      key("mill.flywheel.axis_x", T::Real, "m", "0.0", "Horizontal offset of the rotor axis from the housing centre"),
+      positive(key("mill.flywheel.plate_width", T::Real, "m", "0.3",
+                   "Beater plate width along the axis")),
+      positive(
+          key("mill.flywheel.plate_thickness", T::Real, "m", "0.02", "Beater plate thickness")),
+      positive(key("mill.flywheel.axis_height", T::Real, "m", "1.2",
+                   "Height of the rotor axis above the housing floor")),
+      key("mill.flywheel.axis_x", T::Real, "m", "0.0",
+          "Horizontal offset of the rotor axis from the housing centre"),
       key("mill.inlet.center_x", T::Real, "m", "0.0", "Inlet centre (x) on the housing roof"),
-      positive(key("mill.inlet.size", T::Real, "m", "0.3", "Inlet opening: side of a square on the roof")),
+      positive(key("mill.inlet.size", T::Real, "m", "0.3",
+                   "Inlet opening: side of a square on the roof")),
       key("mill.outlet.center_x", T::Real, "m", "0.0", "Outlet centre (x) on the housing floor"),
-      positive(key("mill.outlet.size", T::Real, "m", "0.4", "Outlet opening: side of a square on the floor")),
+      positive(key("mill.outlet.size", T::Real, "m", "0.4",
+                   "Outlet opening: side of a square on the floor")),
 
       // --- rotor ---
-      positive(key("rotor.rpm", T::RealList, "rpm", "[2000]", "Rotor speeds; one flow/transport run per speed")),
+      positive(key("rotor.rpm", T::RealList, "rpm", "[2000]",
+                   "Rotor speeds; one flow/transport run per speed"))};
+}
 
+// The gas, the CFD numerics (stage 1a) and the sampling of its field.
+std::vector<KeyDef> flow_keys() {
+  return {
       // --- gas ---
       choice("gas.model", "compressible", {"incompressible", "compressible"},
-             "rhoSimpleFoam (air as a perfect gas, the method's model; its temperature carries no rotor work, see docs/flow.md \"Compressible gas\") or simpleFoam (constant density gas.density)"),
-      positive(key("gas.density", T::Real, "kg/m^3", "1.2", "Gas density (incompressible model; reference for drag)")),
+             "rhoSimpleFoam (air as a perfect gas, the method's model; its temperature carries no "
+             "rotor work, see docs/flow.md \"Compressible gas\") or simpleFoam (constant density "
+             "gas.density)"),
+      positive(key("gas.density", T::Real, "kg/m^3", "1.2",
+                   "Gas density (incompressible model; reference for drag)")),
       positive(key("gas.viscosity", T::Real, "Pa s", "1.8e-5", "Gas dynamic viscosity")),
-      positive(key("gas.temperature", T::Real, "K", "293.15", "Gas temperature (compressible model)")),
-      positive(key("gas.pressure", T::Real, "Pa", "101325", "Absolute ambient pressure (compressible model)")),
-      key("gas.outlet_pressure_drop", T::Real, "Pa", "0", "Outlet static pressure below inlet total pressure"),
+      positive(
+          key("gas.temperature", T::Real, "K", "293.15", "Gas temperature (compressible model)")),
+      positive(key("gas.pressure", T::Real, "Pa", "101325",
+                   "Absolute ambient pressure (compressible model)")),
+      key("gas.outlet_pressure_drop", T::Real, "Pa", "0",
+          "Outlet static pressure below inlet total pressure"),
 
       // --- CFD numerics ---
       choice("flow.mesh_preset", "quick", {"tiny", "quick", "medium", "reference"},
-             "tiny: a few thousand cells (tests); quick: tens of thousands (0.1 m background cells); medium: 0.07 m cells with boundary layers; reference: 0.05 m cells with boundary layers; all first-order momentum (flow.momentum_scheme); cell counts and the mesh study in docs/flow.md"),
+             "tiny: a few thousand cells (tests); quick: tens of thousands (0.1 m background "
+             "cells); medium: 0.07 m cells with boundary layers; reference: 0.05 m cells with "
+             "boundary layers; all first-order momentum (flow.momentum_scheme); cell counts and "
+             "the mesh study in docs/flow.md"),
       range(key("flow.rotor_angle", T::Real, "deg", "0",
-                "Frozen-rotor position of the flywheel in the CFD (counter-clockwise about +z; 0: plate 0 along +x). The steady MRF solution depends on it; bench/README.md, \"Flow\", measures the spread over positions"),
+                "Frozen-rotor position of the flywheel in the CFD (counter-clockwise about +z; 0: "
+                "plate 0 along +x). The steady MRF solution depends on it; bench/README.md, "
+                "\"Flow\", measures the spread over positions"),
             0, false, 360, true),
       choice("flow.momentum_scheme", "preset", {"preset", "upwind", "linearUpwind"},
-             "Convection of momentum: preset = the mesh preset's (upwind on every preset); upwind = first order, converges on all presets; linearUpwind = second order (started with flow.first_order_iterations of upwind; does not converge on medium and reference: the plate wakes oscillate, docs/flow.md)"),
+             "Convection of momentum: preset = the mesh preset's (upwind on every preset); upwind "
+             "= first order, converges on all presets; linearUpwind = second order (started with "
+             "flow.first_order_iterations of upwind; does not converge on medium and reference: "
+             "the plate wakes oscillate, docs/flow.md)"),
       at_least(key("flow.first_order_iterations", T::Int, "", "300",
-                   "With second-order momentum (flow.momentum_scheme), first run this many iterations with first-order upwind, then switch (the solver restarts from that state); 0: second order from the start"),
+                   "With second-order momentum (flow.momentum_scheme), first run this many "
+                   "iterations with first-order upwind, then switch (the solver restarts from that "
+                   "state); 0: second order from the start"),
                0),
-      at_least(key("flow.max_iterations", T::Int, "", "600", "Iteration cap of the steady solver"), 1),
-      positive(key("flow.residual_target", T::Real, "", "1e-4", "Initial-residual target for p and U (convergence)")),
+      at_least(key("flow.max_iterations", T::Int, "", "600", "Iteration cap of the steady solver"),
+               1),
+      positive(key("flow.residual_target", T::Real, "", "1e-4",
+                   "Initial-residual target for p and U (convergence)")),
       key("flow.allow_unconverged", T::Bool, "", "false",
-          "Go on with a flow that missed flow.residual_target within flow.max_iterations (sample, transport and what follows run on it; the report says so at the top). false: the sample and transport stages stop with an error naming the run"),
+          "Go on with a flow that missed flow.residual_target within flow.max_iterations (sample, "
+          "transport and what follows run on it; the report says so at the top). false: the sample "
+          "and transport stages stop with an error naming the run"),
       choice("flow.domain", "half", {"half", "full"},
-             "half: solve z >= 0 with a symmetry plane at z = 0 and mirror it (the mill is mirror-symmetric; the full-domain steady solve is carried away by an antisymmetric mode, see docs/flow.md); full: the whole housing"),
+             "half: solve z >= 0 with a symmetry plane at z = 0 and mirror it (the mill is "
+             "mirror-symmetric; the full-domain steady solve is carried away by an antisymmetric "
+             "mode, see docs/flow.md); full: the whole housing"),
 
       // --- sampling of the flow field ---
-      positive(key("sample.spacing", T::Real, "m", "0.05", "Spacing of the uniform 3D sampling grid")),
-      key("sample.turbulence", T::Bool, "", "false", "Also sample k and omega"),
+      positive(
+          key("sample.spacing", T::Real, "m", "0.05", "Spacing of the uniform 3D sampling grid")),
+      key("sample.turbulence", T::Bool, "", "false", "Also sample k and omega")};
+}
 
-      // --- ore injection (stage 1 transport) ---
-      at_least(key("injection.n_lumps", T::Int, "", "360", "Number of ore lumps injected"), 1),
-      positive(key("injection.lump_diameter", T::Real, "m", "0.04", "Lump diameter")),
-      positive(key("injection.duration", T::Real, "s", "0.2", "Lumps are inserted evenly over this time")),
-      positive(key("injection.time_limit", T::Real, "s", "2.0", "Transport run stops at this time")),
-      positive(key("injection.timestep", T::Real, "s", "5e-6", "Particle time step")),
-      at_least(key("injection.seed", T::Int, "", "4711", "Random seed of the insertion"), 1),
-      positive(key("transport.trajectory_interval", T::Real, "s", "2e-3", "Trajectory sampling interval (transport.h5, plot)")),
-      at_least(key("transport.vtk_interval", T::Real, "s", "0.01", "VTK dump interval of lumps and meshes (ParaView); 0 = none"), 0),
-      positive(key("transport.sliding_threshold", T::Real, "m/s", "1.0",
-                   "Contacts whose normal speed relative to the surface is below this are sliding (touch-downs, rolling, chatter): counted apart (summary.json sliding_contacts), left out of the impact statistics and of the beater strikes")),
+// The ore injection and the lumps' transport (stage 1b), and the ore card.
+std::vector<KeyDef> transport_keys() {
+  return {// --- ore injection (stage 1 transport) ---
+          at_least(key("injection.n_lumps", T::Int, "", "360", "Number of ore lumps injected"), 1),
+          positive(key("injection.lump_diameter", T::Real, "m", "0.04", "Lump diameter")),
+          positive(key("injection.duration", T::Real, "s", "0.2",
+                       "Lumps are inserted evenly over this time")),
+          positive(
+              key("injection.time_limit", T::Real, "s", "2.0", "Transport run stops at this time")),
+          positive(key("injection.timestep", T::Real, "s", "5e-6", "Particle time step")),
+          at_least(key("injection.seed", T::Int, "", "4711", "Random seed of the insertion"), 1),
+          positive(key("transport.trajectory_interval", T::Real, "s", "2e-3",
+                       "Trajectory sampling interval (transport.h5, plot)")),
+          at_least(key("transport.vtk_interval", T::Real, "s", "0.01",
+                       "VTK dump interval of lumps and meshes (ParaView); 0 = none"),
+                   0),
+          positive(
+              key("transport.sliding_threshold", T::Real, "m/s", "1.0",
+                  "Contacts whose normal speed relative to the surface is below this are sliding "
+                  "(touch-downs, rolling, chatter): counted apart (summary.json sliding_contacts), "
+                  "left out of the impact statistics and of the beater strikes")),
 
-      // --- ore ---
-      key("ore.card", T::Path, "", "liggghts_inputs/materials/sandstone.yaml",
-          "Ore card (YAML); relative to the case file, else to the project"),
+          // --- ore ---
+          key("ore.card", T::Path, "", "liggghts_inputs/materials/sandstone.yaml",
+              "Ore card (YAML); relative to the case file, else to the project")};
+}
 
-      // --- bonded lump model (stage 2) ---
-      at_least(key("lump.n_elements", T::Int, "", "3344", "Elements (spheres) per lump"), 2),
-      positive(key("lump.diameter", T::Real, "m", "0.04", "Lump diameter")),
-      range(key("lump.radius_spread", T::Real, "", "0.25", "Element radii uniform in (1 +- spread) x mean"), 0, false, 1, true),
-      at_least(key("lump.n_packings", T::Int, "", "1", "Distinct random packings (lumps) for statistics"), 1),
-      at_least(key("lump.seed", T::Int, "", "1001", "Seed of the first packing"), 1),
-      at_least(key("lump.bond_gap", T::Real, "", "0.15", "Bond pairs whose gap is below this x min(Ri, Rj) (0.15: coordination ~6.3 at 3344 elements)"), 0),
-      at_least(key("lump.max_bonds", T::Int, "", "16", "Cap of bonds per element"), 1),
-      bond_key("lump.bond_radius_multiplier", bond_parameter("radius_multiplier"), "1.0"),
-      key("lump.broken_contact", T::Bool, "", "false",
-          "Broken bonds stay as compression-only frictional contacts while the pair is within its bonding range (fix bond/breakable broken_contact)"),
+// The bonded lump (stage 2 and the calibration's specimens).
+std::vector<KeyDef> lump_keys() {
+  return {// --- bonded lump model (stage 2) ---
+          at_least(key("lump.n_elements", T::Int, "", "3344", "Elements (spheres) per lump"), 2),
+          positive(key("lump.diameter", T::Real, "m", "0.04", "Lump diameter")),
+          range(key("lump.radius_spread", T::Real, "", "0.25",
+                    "Element radii uniform in (1 +- spread) x mean"),
+                0, false, 1, true),
+          at_least(key("lump.n_packings", T::Int, "", "1",
+                       "Distinct random packings (lumps) for statistics"),
+                   1),
+          at_least(key("lump.seed", T::Int, "", "1001", "Seed of the first packing"), 1),
+          at_least(key("lump.bond_gap", T::Real, "", "0.15",
+                       "Bond pairs whose gap is below this x min(Ri, Rj) (0.15: coordination ~6.3 "
+                       "at 3344 elements)"),
+                   0),
+          at_least(key("lump.max_bonds", T::Int, "", "16", "Cap of bonds per element"), 1),
+          bond_key("lump.bond_radius_multiplier", bond_parameter("radius_multiplier"), "1.0"),
+          key("lump.broken_contact", T::Bool, "", "false",
+              "Broken bonds stay as compression-only frictional contacts while the pair is within "
+              "its bonding range (fix bond/breakable broken_contact)")};
+}
 
-      // --- breakage sweep (stage 2) ---
-      choice("breakage.conditions", "sweep", {"sweep", "transport"},
-             "sweep: the velocities/angles below; transport: binned from stage 1 impacts"),
-      range(key("breakage.velocities", T::RealList, "m/s", "[4, 10, 20, 40, 60, 80, 100, 120, 150, 169]",
-                "Impact speeds of the sweep (beater mills reach 50-150 m/s; above 500 m/s a rock lump is a shock "
-                "problem the bond model does not describe)"),
-            0, true, 500, false),
-      range(key("breakage.angles", T::RealList, "deg", "[90]", "Impact angles to the surface (90 = normal)"), 0, true, 90, false),
-      at_least(key("breakage.repeats", T::Int, "", "1", "Repeats per condition (random orientation)"), 1),
-      positive(key("breakage.duration_after_contact", T::Real, "s", "6e-3", "Simulated time after first contact, at most")),
-      at_least(key("breakage.quiet_time", T::Real, "s", "1e-3",
-                   "Stop earlier once no bond broke for this long after contact; 0 = always the full duration"), 0),
-      at_least(key("breakage.timestep", T::Real, "s", "0", "Time step; 0 = automatic from the stability limit"), 0),
-      at_least(key("breakage.dump_interval", T::Real, "s", "5e-4", "VTK dump interval; 0 = no dumps"), 0),
-      range(key("breakage.size_fraction_edges", T::RealList, "", "[0, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.85, 1.0]",
-                "Edges of the size fractions, piece diameter / lump diameter (ascending)"), 0, false, 1, false),
-      range(key("breakage.critical_largest_fraction", T::Real, "", "0.05",
-                "Critical velocity: largest piece mass fraction falls below this"), 0, true, 1, true),
-      at_least(key("breakage.velocity_bins", T::Int, "", "5", "transport conditions: bins of impact normal speed"), 1),
-      key("breakage.include_wall_impacts", T::Bool, "", "false", "transport conditions: also wall impacts"),
-      at_least(key("breakage.in_mill.lumps", T::Int, "", "0",
-                   "In-mill breakage (needs conditions: transport): lumps per rotor speed run as bonded lumps in the "
-                   "turning mill from stage 1's first flywheel strikes, chosen spread over the strike speeds; 0 = none"),
-               0),
-      positive(key("breakage.in_mill.duration", T::Real, "s", "0.02",
-                   "In-mill breakage: simulated time of each run, from lead_time before the strike (long enough for "
-                   "the fragments' first housing impacts)")),
-      positive(key("breakage.in_mill.lead_time", T::Real, "s", "2e-3",
-                   "In-mill breakage: a run starts this long before the lump's first flywheel strike (its state "
-                   "backed off ballistically from the strike)")),
-      key("breakage.in_mill.gas", T::Bool, "", "true",
-          "In-mill breakage: gas drag on each element from the sampled field (sample stage); false = no gas"),
-      at_least(key("breakage.in_mill.neighbour_bins", T::Int, "", "4000000",
-                   "In-mill breakage: most neighbour bins over the simulation box, which holds the whole mill "
-                   "(LIGGGHTS clears every bin at each list build); the bins start at the larger of 4 mean element "
-                   "radii and (box volume / this)^(1/3) and grow as the fragments spread"),
-               1000),
+// The breakage stage: its sweep or transport conditions, and the in-mill runs.
+std::vector<KeyDef> breakage_keys() {
+  return {// --- breakage sweep (stage 2) ---
+          choice("breakage.conditions", "sweep", {"sweep", "transport"},
+                 "sweep: the velocities/angles below; transport: binned from stage 1 impacts"),
+          range(key("breakage.velocities", T::RealList, "m/s",
+                    "[4, 10, 20, 40, 60, 80, 100, 120, 150, 169]",
+                    "Impact speeds of the sweep (beater mills reach 50-150 m/s; above 500 m/s a "
+                    "rock lump is a shock "
+                    "problem the bond model does not describe)"),
+                0, true, 500, false),
+          range(key("breakage.angles", T::RealList, "deg", "[90]",
+                    "Impact angles to the surface (90 = normal)"),
+                0, true, 90, false),
+          at_least(key("breakage.repeats", T::Int, "", "1",
+                       "Repeats per condition (random orientation)"),
+                   1),
+          positive(key("breakage.duration_after_contact", T::Real, "s", "6e-3",
+                       "Simulated time after first contact, at most")),
+          at_least(key("breakage.quiet_time", T::Real, "s", "1e-3",
+                       "Stop earlier once no bond broke for this long after contact; 0 = always "
+                       "the full duration"),
+                   0),
+          at_least(key("breakage.timestep", T::Real, "s", "0",
+                       "Time step; 0 = automatic from the stability limit"),
+                   0),
+          at_least(key("breakage.dump_interval", T::Real, "s", "5e-4",
+                       "VTK dump interval; 0 = no dumps"),
+                   0),
+          range(key("breakage.size_fraction_edges", T::RealList, "",
+                    "[0, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.85, 1.0]",
+                    "Edges of the size fractions, piece diameter / lump diameter (ascending)"),
+                0, false, 1, false),
+          range(key("breakage.critical_largest_fraction", T::Real, "", "0.05",
+                    "Critical velocity: largest piece mass fraction falls below this"),
+                0, true, 1, true),
+          at_least(key("breakage.velocity_bins", T::Int, "", "5",
+                       "transport conditions: bins of impact normal speed"),
+                   1),
+          key("breakage.include_wall_impacts", T::Bool, "", "false",
+              "transport conditions: also wall impacts"),
+          at_least(key("breakage.in_mill.lumps", T::Int, "", "0",
+                       "In-mill breakage (needs conditions: transport): lumps per rotor speed run "
+                       "as bonded lumps in the "
+                       "turning mill from stage 1's first flywheel strikes, chosen spread over the "
+                       "strike speeds; 0 = none"),
+                   0),
+          positive(key("breakage.in_mill.duration", T::Real, "s", "0.02",
+                       "In-mill breakage: simulated time of each run, from lead_time before the "
+                       "strike (long enough for "
+                       "the fragments' first housing impacts)")),
+          positive(key("breakage.in_mill.lead_time", T::Real, "s", "2e-3",
+                       "In-mill breakage: a run starts this long before the lump's first flywheel "
+                       "strike (its state "
+                       "backed off ballistically from the strike)")),
+          key("breakage.in_mill.gas", T::Bool, "", "true",
+              "In-mill breakage: gas drag on each element from the sampled field (sample stage); "
+              "false = no gas"),
+          at_least(key("breakage.in_mill.neighbour_bins", T::Int, "", "4000000",
+                       "In-mill breakage: most neighbour bins over the simulation box, which holds "
+                       "the whole mill "
+                       "(LIGGGHTS clears every bin at each list build); the bins start at the "
+                       "larger of 4 mean element "
+                       "radii and (box volume / this)^(1/3) and grow as the fragments spread"),
+                   1000)};
+}
 
+// The calibration's virtual lab tests.
+std::vector<KeyDef> calibrate_keys() {
+  return {
       // --- calibration (virtual lab tests) ---
       at_least(key("calibrate.n_elements", T::Int, "", "1500", "Elements in a lab specimen"), 20),
-      positive(key("calibrate.strain_rate", T::Real, "1/s", "0.5", "Platen strain rate of the UCS and Brazilian tests")),
+      positive(key("calibrate.strain_rate", T::Real, "1/s", "0.5",
+                   "Platen strain rate of the UCS and Brazilian tests")),
       at_least(key("calibrate.max_iterations", T::Int, "", "8", "Calibration iterations cap"), 1),
-      positive(key("calibrate.tolerance", T::Real, "", "0.1", "Relative tolerance on E, UCS and tensile strength")),
+      positive(key("calibrate.tolerance", T::Real, "", "0.1",
+                   "Relative tolerance on E, UCS and tensile strength")),
       at_least(key("calibrate.seed", T::Int, "", "2002", "Seed of the specimen packing"), 1),
       key("calibrate.rate_check", T::Bool, "", "true",
-          "After the fit, repeat the UCS test at half the strain rate (quasi-static check)"),
+          "After the fit, repeat the UCS test at half the strain rate (quasi-static check)")};
+}
 
+// The resources of the engine runs, here and per stage on a cluster.
+std::vector<KeyDef> resources_keys() {
+  std::vector<KeyDef> v = {
       // --- resources ---
-      at_least(key("resources.np", T::Int, "", "1", "MPI ranks per engine run (--np overrides)"), 1),
-      at_least(key("resources.jobs", T::Int, "", "1", "Engine runs at once on this machine (--jobs overrides)"), 1),
+      at_least(key("resources.np", T::Int, "", "1", "MPI ranks per engine run (--np overrides)"),
+               1),
+      at_least(key("resources.jobs", T::Int, "", "1",
+                   "Engine runs at once on this machine (--jobs overrides)"),
+               1),
       matching(key("resources.merge.time", T::String, "", "00:20:00",
                    "Cluster: wall-time limit of the small jobs between stages (merges, planning)"),
-               kSlurmTime, kSlurmTimeText),
-  };
+               kSlurmTime, kSlurmTimeText)};
   // Per stage on a cluster: the flow wants ranks, breakage many one-rank tasks.
-  for (const auto& [stage, time, np, what] :
-       std::vector<std::array<std::string, 4>>{{"flow", "04:00:00", "-", "flow task (one per rotor speed)"},
-                                               {"sample", "00:30:00", "", "sample job"},
-                                               {"transport", "02:00:00", "1", "transport task (one per rotor speed)"},
-                                               {"calibrate", "02:00:00", "1", "calibration job"},
-                                               {"breakage", "01:00:00", "1", "breakage task (one per impact condition)"},
-                                               {"report", "00:30:00", "", "report job"}})
-    for (auto& k : stage_resources(stage, time, np, what)) s.keys.push_back(std::move(k));
+  for (const auto& [stage, time, np, what] : std::vector<std::array<std::string, 4>>{
+           {"flow", "04:00:00", "-", "flow task (one per rotor speed)"},
+           {"sample", "00:30:00", "", "sample job"},
+           {"transport", "02:00:00", "1", "transport task (one per rotor speed)"},
+           {"calibrate", "02:00:00", "1", "calibration job"},
+           {"breakage", "01:00:00", "1", "breakage task (one per impact condition)"},
+           {"report", "00:30:00", "", "report job"}})
+    for (auto& k : stage_resources(stage, time, np, what)) v.push_back(std::move(k));
+  return v;
+}
+
+Schema make_case_schema() {
+  Schema s;
+  s.what = "case file";
+  for (const auto& part : {mill_keys(), flow_keys(), transport_keys(), lump_keys(), breakage_keys(),
+                           calibrate_keys(), resources_keys()})
+    s.keys.insert(s.keys.end(), part.begin(), part.end());
   return s;
 }
 

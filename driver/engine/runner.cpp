@@ -247,4 +247,15 @@ Result Runner::run(const Command& cmd, const Poll& poll) {
   return res;
 }
 
+Result run_python(Runner& runner, const fs::path& script, const std::vector<std::string>& args,
+                  const fs::path& log, const std::string& job) {
+  Command c;
+  c.argv = {"/usr/bin/python3", script.string()};
+  c.argv.insert(c.argv.end(), args.begin(), args.end());
+  c.cwd = log.parent_path();
+  c.log = log;
+  c.job = job;
+  return runner.run(c);
+}
+
 }  // namespace mill::engine

@@ -17,20 +17,20 @@ namespace mill::engine {
 enum class Engine { Generic, Liggghts, OpenFoam };
 
 struct Command {
-  std::vector<std::string> argv;  // program and arguments (no mpirun)
-  std::filesystem::path cwd;      // working directory (must exist)
-  std::filesystem::path log;      // stdout+stderr go here (truncated)
+  std::vector<std::string> argv;           // program and arguments (no mpirun)
+  std::filesystem::path cwd;               // working directory (must exist)
+  std::filesystem::path log;               // stdout+stderr go here (truncated)
   std::map<std::string, std::string> env;  // extra environment
-  int np = 1;                     // > 1: run through mpirun -np N
-  bool mpi = false;               // true: use mpirun even for np == 1
+  int np = 1;                              // > 1: run through mpirun -np N
+  bool mpi = false;                        // true: use mpirun even for np == 1
   Engine engine = Engine::Generic;
-  std::string job;                // label for messages: "breakage/v150_a90_r0"
+  std::string job;  // label for messages: "breakage/v150_a90_r0"
 };
 
 struct Result {
-  int exit_code = 0;    // exit status, or -1 when killed by a signal
-  int signal = 0;       // terminating signal, 0 if none
-  double seconds = 0;   // wall time
+  int exit_code = 0;                     // exit status, or -1 when killed by a signal
+  int signal = 0;                        // terminating signal, 0 if none
+  double seconds = 0;                    // wall time
   std::vector<std::string> error_lines;  // the engine's own error lines
 };
 
@@ -63,6 +63,13 @@ class Runner {
   // Error lines the given engine writes in its log.
   static std::vector<std::string> scan_errors(const std::filesystem::path& log, Engine e);
 };
+
+// Runs a plotting script of postprocess/ with Debian's python3 (it has
+// matplotlib): `python3 script args...` in the folder of `log`, its output
+// into `log`; `job` names it in messages. Throws as Runner::run does.
+Result run_python(Runner& runner, const std::filesystem::path& script,
+                  const std::vector<std::string>& args, const std::filesystem::path& log,
+                  const std::string& job);
 
 // Install SIGINT/SIGTERM handlers that forward the signal to running
 // children (their process groups) and make Runner::run throw Interrupted.

@@ -53,10 +53,14 @@ bool num(const json& v) { return v.is_number(); }
 double d(const json& v) { return v.get<double>(); }
 
 // A number with about three significant figures, no exponent for everyday sizes.
-std::string g3(double x) { return std::abs(x) >= 100 ? fmt::format("{:.0f}", x) : fmt::format("{:.3g}", x); }
+std::string g3(double x) {
+  return std::abs(x) >= 100 ? fmt::format("{:.0f}", x) : fmt::format("{:.3g}", x);
+}
 
 // A speed in whole m/s (two figures below 10 m/s).
-std::string speed(double v) { return std::abs(v) >= 10 ? fmt::format("{:.0f}", v) : fmt::format("{:.2g}", v); }
+std::string speed(double v) {
+  return std::abs(v) >= 10 ? fmt::format("{:.0f}", v) : fmt::format("{:.2g}", v);
+}
 
 // "2000 rpm" from "rpm2000".
 std::string rpm_words(const std::string& key) { return key.substr(3) + " rpm"; }
@@ -74,9 +78,11 @@ std::vector<HeadlineRow> efficiency_rows(const json& eff) {
   if (!eff.is_array()) return rows;
   for (const auto& e : eff) {
     if (!num(pick(e, "mean"))) continue;
-    const std::string at = num(pick(e, "angle_deg")) ? fmt::format(", {:g} deg", d(e.at("angle_deg"))) : "";
+    const std::string at =
+        num(pick(e, "angle_deg")) ? fmt::format(", {:g} deg", d(e.at("angle_deg"))) : "";
     const std::string range = num(pick(e, "min")) && num(pick(e, "max"))
-                                  ? fmt::format("{}-{} over the sweep", percent3(d(e.at("min"))), percent3(d(e.at("max"))))
+                                  ? fmt::format("{}-{} over the sweep", percent3(d(e.at("min"))),
+                                                percent3(d(e.at("max"))))
                                   : "";
     rows.push_back({"", "comminution efficiency at the critical speed" + at,
                     num(pick(e, "at_critical_speed"))
@@ -86,24 +92,14 @@ std::vector<HeadlineRow> efficiency_rows(const json& eff) {
                     true});
     if (num(pick(e, "ledger_residual_fraction_max")))
       rows.push_back({"", "energy ledger residual, largest of the impacts" + at,
-                      percent3(d(e.at("ledger_residual_fraction_max"))) + " of the energy given", false});
+                      percent3(d(e.at("ledger_residual_fraction_max"))) + " of the energy given",
+                      false});
   }
   return rows;
 }
 
-}  // namespace
-
-const std::vector<HeadlineGroup>& headline_groups() {
-  static const std::vector<HeadlineGroup> g = {{"flow", "Gas flow (stage 1a)"},
-                                               {"transport", "Ore lumps through the mill (stage 1b)"},
-                                               {"calibrate", "Calibration of the bond model"},
-                                               {"breakage", "Breakage of one lump (stage 2)"},
-                                               {"breakage", "Mill product, one pass (stages 1 and 2)"}};
-  return g;
-}
-
-json headline_json(const fs::path& run, Problems* problems) {
-  json h = json::object();
+// headline.json's "flow": per rotor speed, the flow report's figures.
+void flow_json(const fs::path& run, Problems* problems, json& h) {
   for (const auto& rpm : rpm_dirs(run / "flow")) {
     const auto f = read_json(run / "flow" / rpm / "flow_report.json", problems);
     if (f.is_null()) continue;
@@ -125,38 +121,49 @@ json headline_json(const fs::path& run, Problems* problems) {
     if (num(pick(back, "inlet_out"))) e["backflow_inlet_out_kg_s"] = pick(back, "inlet_out");
     // How settled the mass flow was (last tenth of the iterations) and, for
     // the compressible gas, the energy balance of the openings.
-    const json spread = pick(pick(pick(f, "history_last_tenth"), "mass_flow_inlet_kg_s"), "spread_relative");
+    const json spread =
+        pick(pick(pick(f, "history_last_tenth"), "mass_flow_inlet_kg_s"), "spread_relative");
     if (num(spread)) e["mass_flow_spread_last_tenth"] = spread;
     e["gas_model"] = pick(f, "gas_model");
     const json eb = pick(f, "energy_balance");
-    if (num(pick(eb, "total_temperature_rise_K")) && num(pick(eb, "expected_rise_from_shaft_power_K"))) {
+    if (num(pick(eb, "total_temperature_rise_K")) &&
+        num(pick(eb, "expected_rise_from_shaft_power_K"))) {
       e["gas_temperature_rise_K"] = pick(eb, "total_temperature_rise_K");
       e["gas_temperature_rise_adiabatic_K"] = pick(eb, "expected_rise_from_shaft_power_K");
     }
     h["flow"][rpm] = e;
   }
+}
+
+// headline.json's "transport": per rotor speed, the transport summary's figures.
+void transport_json(const fs::path& run, Problems* problems, json& h) {
   for (const auto& rpm : rpm_dirs(run / "transport")) {
     const auto t = read_json(run / "transport" / rpm / "summary.json", problems);
     if (t.is_null()) continue;
-    h["transport"][rpm] = {{"lumps", pick(t, "n_particles")},
-                           {"flywheel_impacts", pick(t, "n_flywheel_impacts")},
-                           {"wall_impacts", pick(t, "n_wall_impacts")},
-                           {"flywheel_impact_speed_mean_m_s", pick(t, "flywheel_impact_speed_mean_m_s")},
-                           {"flywheel_impact_speed_std_m_s", pick(t, "flywheel_impact_speed_std_m_s")},
-                           {"flywheel_normal_speed_mean_m_s", pick(t, "flywheel_normal_speed_mean_m_s")},
-                           {"flywheel_angle_mean_deg", pick(t, "flywheel_angle_mean_deg")},
-                           {"flywheel_first_strike_speed_mean_m_s", pick(t, "flywheel_first_strike_speed_mean_m_s")},
-                           {"flywheel_rebound_speed_lab_mean_m_s", pick(t, "flywheel_rebound_speed_lab_mean_m_s")},
-                           {"flywheel_rebound_speed_lab_std_m_s", pick(t, "flywheel_rebound_speed_lab_std_m_s")},
-                           {"strike_to_housing_speed_mean_m_s", pick(t, "strike_to_housing_speed_mean_m_s")},
-                           {"strike_to_housing_speed_std_m_s", pick(t, "strike_to_housing_speed_std_m_s")},
-                           {"strike_to_housing_angle_mean_deg", pick(t, "strike_to_housing_angle_mean_deg")},
-                           {"strike_to_housing_flight_time_mean_s", pick(t, "strike_to_housing_flight_time_mean_s")},
-                           {"n_strike_to_housing", pick(t, "n_strike_to_housing")},
-                           {"sliding_contacts", pick(t, "sliding_contacts")},
-                           {"sliding_threshold_m_s", pick(t, "sliding_threshold_m_s")},
-                           {"flow_converged", pick(t, "flow_converged")}};
+    h["transport"][rpm] = {
+        {"lumps", pick(t, "n_particles")},
+        {"flywheel_impacts", pick(t, "n_flywheel_impacts")},
+        {"wall_impacts", pick(t, "n_wall_impacts")},
+        {"flywheel_impact_speed_mean_m_s", pick(t, "flywheel_impact_speed_mean_m_s")},
+        {"flywheel_impact_speed_std_m_s", pick(t, "flywheel_impact_speed_std_m_s")},
+        {"flywheel_normal_speed_mean_m_s", pick(t, "flywheel_normal_speed_mean_m_s")},
+        {"flywheel_angle_mean_deg", pick(t, "flywheel_angle_mean_deg")},
+        {"flywheel_first_strike_speed_mean_m_s", pick(t, "flywheel_first_strike_speed_mean_m_s")},
+        {"flywheel_rebound_speed_lab_mean_m_s", pick(t, "flywheel_rebound_speed_lab_mean_m_s")},
+        {"flywheel_rebound_speed_lab_std_m_s", pick(t, "flywheel_rebound_speed_lab_std_m_s")},
+        {"strike_to_housing_speed_mean_m_s", pick(t, "strike_to_housing_speed_mean_m_s")},
+        {"strike_to_housing_speed_std_m_s", pick(t, "strike_to_housing_speed_std_m_s")},
+        {"strike_to_housing_angle_mean_deg", pick(t, "strike_to_housing_angle_mean_deg")},
+        {"strike_to_housing_flight_time_mean_s", pick(t, "strike_to_housing_flight_time_mean_s")},
+        {"n_strike_to_housing", pick(t, "n_strike_to_housing")},
+        {"sliding_contacts", pick(t, "sliding_contacts")},
+        {"sliding_threshold_m_s", pick(t, "sliding_threshold_m_s")},
+        {"flow_converged", pick(t, "flow_converged")}};
   }
+}
+
+// headline.json's "calibration": the calibration report's targets and results.
+void calibration_json(const fs::path& run, Problems* problems, json& h) {
   const auto cal = read_json(run / "calibrate" / "report.json", problems);
   if (!cal.is_null())
     h["calibration"] = {{"source", pick(cal, "source")},
@@ -164,6 +171,10 @@ json headline_json(const fs::path& run, Problems* problems) {
                         {"targets", pick(cal, "targets")},
                         {"achieved", pick(cal, "achieved")},
                         {"within_tolerance", pick(cal, "within_tolerance")}};
+}
+
+// headline.json's "breakage": critical speeds, comminution efficiency, JK fit.
+void breakage_json(const fs::path& run, Problems* problems, json& h) {
   const auto crit = read_json(run / "breakage" / "critical_velocity.json", problems);
   if (crit.is_array()) {
     json c = json::array();
@@ -180,8 +191,8 @@ json headline_json(const fs::path& run, Problems* problems) {
     json c = json::array();
     for (const auto& e : eff) {
       json x = json::object();
-      for (const char* k : {"angle_deg", "critical_velocity_m_s", "at_critical_speed", "mean", "min", "max",
-                            "impacts", "ledger_residual_fraction_max"})
+      for (const char* k : {"angle_deg", "critical_velocity_m_s", "at_critical_speed", "mean",
+                            "min", "max", "impacts", "ledger_residual_fraction_max"})
         x[k] = pick(e, k);
       c.push_back(x);
     }
@@ -191,14 +202,20 @@ json headline_json(const fs::path& run, Problems* problems) {
   if (jk.is_array()) {
     json c = json::array();
     for (const auto& e : jk) {
-      json x = {{"angle_deg", pick(e, "angle_deg")}, {"fitted", pick(e, "fitted")}, {"ore_card", pick(e, "ore_card")}};
-      for (const char* k : {"A_percent", "b_t_per_kWh", "A_times_b", "over_repeats", "repeats_fitted", "reason",
-                            "points_used", "points"})
+      json x = {{"angle_deg", pick(e, "angle_deg")},
+                {"fitted", pick(e, "fitted")},
+                {"ore_card", pick(e, "ore_card")}};
+      for (const char* k : {"A_percent", "b_t_per_kWh", "A_times_b", "over_repeats",
+                            "repeats_fitted", "reason", "points_used", "points"})
         if (e.contains(k)) x[k] = e.at(k);
       c.push_back(x);
     }
     h["breakage"]["jk"] = c;
   }
+}
+
+// headline.json's "product": per rotor speed, the mill product (and the in-mill runs').
+void product_json(const fs::path& run, Problems* problems, json& h) {
   const auto prod = read_json(run / "breakage" / "product.json", problems);
   if (prod.is_array())
     for (const auto& p : prod)
@@ -219,21 +236,24 @@ json headline_json(const fs::path& run, Problems* problems) {
       if (num(pick(p, "rpm")) && pick(p, "in_mill").is_object()) {
         const json& m = p.at("in_mill");
         json x;
-        for (const char* k : {"lumps", "fully_shredded_mass_fraction", "largest_piece_mass_fraction", "t10_percent",
-                              "t10_resolved", "bonds_broken_at_strike_fraction", "p50_mm", "p80_mm"})
+        for (const char* k :
+             {"lumps", "fully_shredded_mass_fraction", "largest_piece_mass_fraction", "t10_percent",
+              "t10_resolved", "bonds_broken_at_strike_fraction", "p50_mm", "p80_mm"})
           x[k] = pick(m, k);
         h["product"][fmt::format("rpm{:g}", d(pick(p, "rpm")))]["in_mill"] = x;
       }
-  return h;
 }
 
-std::vector<HeadlineRow> headline_rows(const json& h) {
-  std::vector<HeadlineRow> rows;
-  const auto& groups = headline_groups();
-  auto add = [&](size_t group, std::string what, std::string value, bool brief = true) {
-    rows.push_back({groups[group].title, std::move(what), std::move(value), brief});
-  };
+// Appends rows under the titles of headline_groups().
+struct RowAdder {
+  std::vector<HeadlineRow>& rows;
+  void operator()(size_t group, std::string what, std::string value, bool brief = true) const {
+    rows.push_back({headline_groups()[group].title, std::move(what), std::move(value), brief});
+  }
+};
 
+// The rows of the gas flow, per rotor speed.
+void flow_rows(const json& h, const RowAdder& add) {
   const json flow = pick(h, "flow");
   for (const auto& rpm : rpm_keys(flow)) {
     const json& f = flow.at(rpm);
@@ -244,7 +264,8 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
               (num(pick(f, "mass_imbalance_relative"))
                    ? (d(f.at("mass_imbalance_relative")) < 1e-4
                           ? std::string(" (in/out differ by < 0.01%)")
-                          : fmt::format(" (in/out differ by {:.2g}%)", 100 * d(f.at("mass_imbalance_relative"))))
+                          : fmt::format(" (in/out differ by {:.2g}%)",
+                                        100 * d(f.at("mass_imbalance_relative"))))
                    : "") +
               (num(pick(f, "mass_flow_spread_last_tenth"))
                    ? fmt::format("; varied by {:.2g}% over the last tenth of the iterations",
@@ -252,17 +273,22 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
                    : ""));
     if (num(pick(f, "gas_temperature_rise_K")) && num(pick(f, "gas_temperature_rise_adiabatic_K")))
       add(0, "gas heating (not predicted)" + at,
-          fmt::format("solved {} K; the shaft power would heat the gas by {} K with adiabatic walls, "
-                      "but the rotor's work does not enter the solver's energy equation (docs/flow.md)",
-                      g3(d(f.at("gas_temperature_rise_K"))), g3(d(f.at("gas_temperature_rise_adiabatic_K")))),
+          fmt::format(
+              "solved {} K; the shaft power would heat the gas by {} K with adiabatic walls, "
+              "but the rotor's work does not enter the solver's energy equation (docs/flow.md)",
+              g3(d(f.at("gas_temperature_rise_K"))),
+              g3(d(f.at("gas_temperature_rise_adiabatic_K")))),
           false);
     if (num(pick(f, "shaft_power_W")))
       add(0, "flywheel shaft power (gas only)" + at,
           fmt::format("{} kW", g3(d(f.at("shaft_power_W")) / 1000)) +
-              (num(pick(f, "shaft_torque_Nm")) ? fmt::format(" ({} N m)", g3(d(f.at("shaft_torque_Nm")))) : ""));
+              (num(pick(f, "shaft_torque_Nm"))
+                   ? fmt::format(" ({} N m)", g3(d(f.at("shaft_torque_Nm"))))
+                   : ""));
     if (num(pick(f, "backflow_outlet_in_kg_s")) && num(pick(f, "backflow_inlet_out_kg_s")))
       add(0, "backflow: in through the outlet, out through the inlet" + at,
-          fmt::format("{} / {} kg/s", g3(d(f.at("backflow_outlet_in_kg_s"))), g3(d(f.at("backflow_inlet_out_kg_s")))),
+          fmt::format("{} / {} kg/s", g3(d(f.at("backflow_outlet_in_kg_s"))),
+                      g3(d(f.at("backflow_inlet_out_kg_s")))),
           false);
     if (num(pick(f, "iterations"))) {
       std::string mesh;
@@ -270,69 +296,84 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
       if (num(pick(f, "cells")))
         mesh += (mesh.empty() ? "" : ", ") + std::to_string(f.at("cells").get<long>()) + " cells";
       add(0, "flow solution" + at,
-          fmt::format("{} {} iterations{}", pick(f, "converged") == true ? "converged in" : "not converged after",
+          fmt::format("{} {} iterations{}",
+                      pick(f, "converged") == true ? "converged in" : "not converged after",
                       f.at("iterations").get<long>(), mesh.empty() ? "" : " (" + mesh + ")"),
           false);
     }
     if (num(pick(f, "rim_gas_speed_to_tip_speed")))
-      add(0, "gas speed near the rim" + at, fmt::format("{:.2f} x the tip speed", d(f.at("rim_gas_speed_to_tip_speed"))),
-          false);
+      add(0, "gas speed near the rim" + at,
+          fmt::format("{:.2f} x the tip speed", d(f.at("rim_gas_speed_to_tip_speed"))), false);
   }
+}
 
+// The rows of the lumps' transport, per rotor speed.
+void transport_rows(const json& h, const RowAdder& add) {
   const json tr = pick(h, "transport");
   for (const auto& rpm : rpm_keys(tr)) {
     const json& t = tr.at(rpm);
     const std::string at = ", " + rpm_words(rpm);
     if (num(pick(t, "lumps")))
       add(1, "lumps and their impacts" + at,
-          fmt::format("{} lumps: {} impacts on the flywheel, {} on the walls", t.at("lumps").get<long>(),
+          fmt::format("{} lumps: {} impacts on the flywheel, {} on the walls",
+                      t.at("lumps").get<long>(),
                       num(pick(t, "flywheel_impacts")) ? t.at("flywheel_impacts").get<long>() : 0L,
                       num(pick(t, "wall_impacts")) ? t.at("wall_impacts").get<long>() : 0L),
           false);
     if (num(pick(t, "flywheel_impact_speed_mean_m_s")))
       add(1, "flywheel impact speed" + at,
-          fmt::format("{} m/s{}{}{}", speed(d(t.at("flywheel_impact_speed_mean_m_s"))),
-                      num(pick(t, "flywheel_impact_speed_std_m_s"))
-                          ? fmt::format(" ± {} (sd)", speed(d(t.at("flywheel_impact_speed_std_m_s"))))
-                          : "",
-                      num(pick(t, "flywheel_normal_speed_mean_m_s"))
-                          ? fmt::format(", normal part {} m/s", speed(d(t.at("flywheel_normal_speed_mean_m_s"))))
-                          : "",
-                      num(pick(t, "flywheel_angle_mean_deg"))
-                          ? fmt::format(", {:.0f} deg to the surface", d(t.at("flywheel_angle_mean_deg")))
-                          : "") +
+          fmt::format(
+              "{} m/s{}{}{}", speed(d(t.at("flywheel_impact_speed_mean_m_s"))),
+              num(pick(t, "flywheel_impact_speed_std_m_s"))
+                  ? fmt::format(" ± {} (sd)", speed(d(t.at("flywheel_impact_speed_std_m_s"))))
+                  : "",
+              num(pick(t, "flywheel_normal_speed_mean_m_s"))
+                  ? fmt::format(", normal part {} m/s",
+                                speed(d(t.at("flywheel_normal_speed_mean_m_s"))))
+                  : "",
+              num(pick(t, "flywheel_angle_mean_deg"))
+                  ? fmt::format(", {:.0f} deg to the surface", d(t.at("flywheel_angle_mean_deg")))
+                  : "") +
               (num(pick(t, "flywheel_first_strike_speed_mean_m_s"))
-                   ? fmt::format("; first strike of a lump {} m/s", speed(d(t.at("flywheel_first_strike_speed_mean_m_s"))))
+                   ? fmt::format("; first strike of a lump {} m/s",
+                                 speed(d(t.at("flywheel_first_strike_speed_mean_m_s"))))
                    : ""));
     if (num(pick(t, "flywheel_rebound_speed_lab_mean_m_s")))
       add(1, "speed of the lumps leaving the beaters (lab frame)" + at,
-          fmt::format("{} m/s{}", speed(d(t.at("flywheel_rebound_speed_lab_mean_m_s"))),
-                      num(pick(t, "flywheel_rebound_speed_lab_std_m_s"))
-                          ? fmt::format(" ± {} (sd)", speed(d(t.at("flywheel_rebound_speed_lab_std_m_s"))))
-                          : ""));
+          fmt::format(
+              "{} m/s{}", speed(d(t.at("flywheel_rebound_speed_lab_mean_m_s"))),
+              num(pick(t, "flywheel_rebound_speed_lab_std_m_s"))
+                  ? fmt::format(" ± {} (sd)", speed(d(t.at("flywheel_rebound_speed_lab_std_m_s"))))
+                  : ""));
     if (num(pick(t, "strike_to_housing_speed_mean_m_s")) && num(pick(t, "n_strike_to_housing")) &&
         t.at("n_strike_to_housing").get<long>() > 0)
       add(1, "housing impact after a beater strike" + at,
-          fmt::format("{} m/s{}{}{}", speed(d(t.at("strike_to_housing_speed_mean_m_s"))),
-                      num(pick(t, "strike_to_housing_speed_std_m_s"))
-                          ? fmt::format(" ± {} (sd)", speed(d(t.at("strike_to_housing_speed_std_m_s"))))
-                          : "",
-                      num(pick(t, "strike_to_housing_angle_mean_deg"))
-                          ? fmt::format(", {:.0f} deg to the wall", d(t.at("strike_to_housing_angle_mean_deg")))
-                          : "",
-                      num(pick(t, "strike_to_housing_flight_time_mean_s"))
-                          ? fmt::format(", {} ms after leaving the beater",
-                                        g3(1e3 * d(t.at("strike_to_housing_flight_time_mean_s"))))
-                          : ""));
+          fmt::format(
+              "{} m/s{}{}{}", speed(d(t.at("strike_to_housing_speed_mean_m_s"))),
+              num(pick(t, "strike_to_housing_speed_std_m_s"))
+                  ? fmt::format(" ± {} (sd)", speed(d(t.at("strike_to_housing_speed_std_m_s"))))
+                  : "",
+              num(pick(t, "strike_to_housing_angle_mean_deg"))
+                  ? fmt::format(", {:.0f} deg to the wall",
+                                d(t.at("strike_to_housing_angle_mean_deg")))
+                  : "",
+              num(pick(t, "strike_to_housing_flight_time_mean_s"))
+                  ? fmt::format(", {} ms after leaving the beater",
+                                g3(1e3 * d(t.at("strike_to_housing_flight_time_mean_s"))))
+                  : ""));
     if (num(pick(t, "sliding_contacts")))
       add(1, "sliding contacts (left out of the impact figures)" + at,
-          fmt::format("{}{}", t.at("sliding_contacts").get<long>(),
-                      num(pick(t, "sliding_threshold_m_s"))
-                          ? fmt::format(" below {:g} m/s normal speed", d(t.at("sliding_threshold_m_s")))
-                          : ""),
+          fmt::format(
+              "{}{}", t.at("sliding_contacts").get<long>(),
+              num(pick(t, "sliding_threshold_m_s"))
+                  ? fmt::format(" below {:g} m/s normal speed", d(t.at("sliding_threshold_m_s")))
+                  : ""),
           false);
   }
+}
 
+// The rows of the calibration: the bonds' source, or each target's result.
+void calibration_rows(const json& h, const RowAdder& add) {
   const json cal = pick(h, "calibration");
   if (cal.is_object()) {
     if (pick(cal, "source") == "ore card") {
@@ -353,25 +394,31 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
         if (!num(a)) continue;
         const json ok = pick(pick(cal, "within_tolerance"), p.key);
         add(2, p.what,
-            fmt::format("{} of {}{}{}", g3(d(a) * p.scale), num(t) ? g3(d(t) * p.scale) : "?", *p.unit ? " " : "",
-                        p.unit) +
+            fmt::format("{} of {}{}{}", g3(d(a) * p.scale), num(t) ? g3(d(t) * p.scale) : "?",
+                        *p.unit ? " " : "", p.unit) +
                 (ok.is_boolean() ? (ok.get<bool>() ? ": met" : ": not met") : ""),
             p.brief);
       }
     }
   }
+}
 
+// The rows of one lump's breakage: critical speeds, efficiency, JK parameters.
+void breakage_rows(const json& h, const RowAdder& add) {
   const json crit = pick(pick(h, "breakage"), "critical_speed");
   if (crit.is_array())
     for (const auto& c : crit) {
       const json thr = pick(c, "largest_fraction_threshold");
-      std::string what = "critical impact speed" + (num(thr) ? " (largest piece < " + percent(d(thr)) + ")" : "");
+      std::string what =
+          "critical impact speed" + (num(thr) ? " (largest piece < " + percent(d(thr)) + ")" : "");
       if (num(pick(c, "angle_deg"))) what += fmt::format(", {:g} deg", d(c.at("angle_deg")));
       std::string v = "not reached in the sweep";
       if (num(pick(c, "critical_velocity_m_s"))) {
         v = speed(d(c.at("critical_velocity_m_s"))) + " m/s";
-        if (num(pick(c, "min_m_s")) && num(pick(c, "max_m_s")) && d(c.at("min_m_s")) < d(c.at("max_m_s")))
-          v += fmt::format(" ({}-{} over repeats)", speed(d(c.at("min_m_s"))), speed(d(c.at("max_m_s"))));
+        if (num(pick(c, "min_m_s")) && num(pick(c, "max_m_s")) &&
+            d(c.at("min_m_s")) < d(c.at("max_m_s")))
+          v += fmt::format(" ({}-{} over repeats)", speed(d(c.at("min_m_s"))),
+                           speed(d(c.at("max_m_s"))));
       }
       add(3, what, v);
     }
@@ -384,23 +431,29 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
       std::string what = "JK breakage parameters";
       if (num(pick(j, "angle_deg"))) what += fmt::format(", {:g} deg", d(j.at("angle_deg")));
       if (pick(j, "fitted") == true) {
-        std::string v = fmt::format("A {}%, b {} t/kWh, A x b {}", g3(d(j.at("A_percent"))), g3(d(j.at("b_t_per_kWh"))),
-                                    g3(d(j.at("A_times_b"))));
+        std::string v = fmt::format("A {}%, b {} t/kWh, A x b {}", g3(d(j.at("A_percent"))),
+                                    g3(d(j.at("b_t_per_kWh"))), g3(d(j.at("A_times_b"))));
         const json ab = pick(pick(j, "over_repeats"), "A_times_b");
         const json n = pick(j, "repeats_fitted");
         if (num(n) && n.get<int>() > 1 && num(pick(ab, "min")))
-          v += fmt::format(" (A x b {}-{} over {} repeats)", g3(d(ab.at("min"))), g3(d(ab.at("max"))), n.get<int>());
+          v += fmt::format(" (A x b {}-{} over {} repeats)", g3(d(ab.at("min"))),
+                           g3(d(ab.at("max"))), n.get<int>());
         add(3, what, v);
       } else {
-        add(3, what, "not fitted: " + (pick(j, "reason").is_string() ? j.at("reason").get<std::string>() : std::string("?")));
+        add(3, what,
+            "not fitted: " + (pick(j, "reason").is_string() ? j.at("reason").get<std::string>()
+                                                            : std::string("?")));
       }
       if (pick(j, "ore_card").is_object()) card = j.at("ore_card");
     }
   if (card.is_object())
     add(3, "JK breakage parameters measured (ore card)",
-        fmt::format("A {}%, b {} t/kWh, A x b {}", g3(d(card.at("A_percent"))), g3(d(card.at("b_t_per_kWh"))),
-                    g3(d(card.at("A_times_b")))));
+        fmt::format("A {}%, b {} t/kWh, A x b {}", g3(d(card.at("A_percent"))),
+                    g3(d(card.at("b_t_per_kWh"))), g3(d(card.at("A_times_b")))));
+}
 
+// The rows of the mill product, per rotor speed.
+void product_rows(const json& h, const RowAdder& add) {
   const json prod = pick(h, "product");
   for (const auto& rpm : rpm_keys(prod)) {
     const json& p = prod.at(rpm);
@@ -410,32 +463,74 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
       if (num(pick(p, "finest_sieve_mm"))) return "< " + g3(d(p.at("finest_sieve_mm"))) + " mm";
       return std::string("?");
     };
-    if (p.contains("p80_mm")) add(4, "product P80" + at, size("p80_mm") + " (P50 " + size("p50_mm") + ")");
+    if (p.contains("p80_mm"))
+      add(4, "product P80" + at, size("p80_mm") + " (P50 " + size("p50_mm") + ")");
     if (num(pick(p, "fully_shredded_mass_fraction")))
-      add(4, "fully shredded (single elements)" + at, percent(d(p.at("fully_shredded_mass_fraction"))) + " of the mass");
+      add(4, "fully shredded (single elements)" + at,
+          percent(d(p.at("fully_shredded_mass_fraction"))) + " of the mass");
     if (num(pick(p, "t10_percent")))
-      add(4, "t10 (finer than a tenth of the feed)" + at, fmt::format("{:.0f}%", d(p.at("t10_percent"))), false);
+      add(4, "t10 (finer than a tenth of the feed)" + at,
+          fmt::format("{:.0f}%", d(p.at("t10_percent"))), false);
     if (num(pick(p, "largest_piece_mass_fraction")))
       add(4, "largest piece" + at,
-          percent(d(p.at("largest_piece_mass_fraction"))) + " of a lump (mean over the impact conditions)", false);
+          percent(d(p.at("largest_piece_mass_fraction"))) +
+              " of a lump (mean over the impact conditions)",
+          false);
     // Beside it, the lumps run in the mill: the strike and what follows.
     const json m = pick(p, "in_mill");
     if (m.is_object() && num(pick(m, "fully_shredded_mass_fraction"))) {
-      std::string v = fmt::format("fully shredded {} of the mass, largest piece {}, t10 {:.0f}%{}",
-                                  percent(d(m.at("fully_shredded_mass_fraction"))),
-                                  num(pick(m, "largest_piece_mass_fraction")) ? percent(d(m.at("largest_piece_mass_fraction")))
-                                                                               : std::string("?"),
-                                  num(pick(m, "t10_percent")) ? d(m.at("t10_percent")) : 0.0,
-                                  pick(m, "t10_resolved").is_boolean() && !m.at("t10_resolved").get<bool>()
-                                      ? " (unresolved: elements too coarse)"
-                                      : "");
+      std::string v =
+          fmt::format("fully shredded {} of the mass, largest piece {}, t10 {:.0f}%{}",
+                      percent(d(m.at("fully_shredded_mass_fraction"))),
+                      num(pick(m, "largest_piece_mass_fraction"))
+                          ? percent(d(m.at("largest_piece_mass_fraction")))
+                          : std::string("?"),
+                      num(pick(m, "t10_percent")) ? d(m.at("t10_percent")) : 0.0,
+                      pick(m, "t10_resolved").is_boolean() && !m.at("t10_resolved").get<bool>()
+                          ? " (unresolved: elements too coarse)"
+                          : "");
       if (num(pick(m, "bonds_broken_at_strike_fraction")))
         v += fmt::format("; {} of the broken bonds broke at the beater strike",
                          percent(d(m.at("bonds_broken_at_strike_fraction"))));
       const int lumps = num(pick(m, "lumps")) ? static_cast<int>(d(m.at("lumps"))) : 0;
-      add(4, fmt::format("in the mill ({} lump{}, strike and housing impacts){}", lumps, lumps == 1 ? "" : "s", at), v);
+      add(4,
+          fmt::format("in the mill ({} lump{}, strike and housing impacts){}", lumps,
+                      lumps == 1 ? "" : "s", at),
+          v);
     }
   }
+}
+
+}  // namespace
+
+const std::vector<HeadlineGroup>& headline_groups() {
+  static const std::vector<HeadlineGroup> g = {
+      {"flow", "Gas flow (stage 1a)"},
+      {"transport", "Ore lumps through the mill (stage 1b)"},
+      {"calibrate", "Calibration of the bond model"},
+      {"breakage", "Breakage of one lump (stage 2)"},
+      {"breakage", "Mill product, one pass (stages 1 and 2)"}};
+  return g;
+}
+
+json headline_json(const fs::path& run, Problems* problems) {
+  json h = json::object();
+  flow_json(run, problems, h);
+  transport_json(run, problems, h);
+  calibration_json(run, problems, h);
+  breakage_json(run, problems, h);
+  product_json(run, problems, h);
+  return h;
+}
+
+std::vector<HeadlineRow> headline_rows(const json& h) {
+  std::vector<HeadlineRow> rows;
+  const RowAdder add{rows};
+  flow_rows(h, add);
+  transport_rows(h, add);
+  calibration_rows(h, add);
+  breakage_rows(h, add);
+  product_rows(h, add);
   return rows;
 }
 

@@ -12,12 +12,12 @@
 #include "jobs/job_store.h"
 #include "jobs/output_checks.h"
 #include "lump/bond_parameters.h"
+#include "lump/material.h"
 #include "progress.h"
 #include "stages/calibrate/fitting.h"
 #include "stages/calibrate/lab_runs.h"
 #include "stages/calibrate/outputs.h"
 #include "stages/calibrate/specimen.h"
-#include "stages/material.h"
 #include "stages/stage_util.h"
 
 namespace mill {
@@ -150,7 +150,7 @@ void Calibration::run() {
 Plan CalibrateStage::plan(const StageContext& ctx) const {
   Plan p;
   nlohmann::json in = case_keys(ctx.cfg.doc, {"calibrate.", "lump."});
-  in["ore"] = ore_keys(ctx.cfg.ore);
+  in["ore"] = config::ore_keys(ctx.cfg.ore);
   in["deck_version"] = kDeckVersion;
   const bool from_card = card_is_calibrated(ctx.cfg);
   if (card_has_stale_calibration(ctx.cfg)) {

@@ -34,15 +34,18 @@ std::vector<fs::path> report_inputs(const fs::path& run) {
   for (const char* stage : {"flow", "sample", "transport", "calibrate", "breakage"}) {
     const fs::path d = run / stage;
     if (!fs::is_directory(d)) continue;
-    for (auto it = fs::recursive_directory_iterator(d); it != fs::recursive_directory_iterator(); ++it) {
+    for (auto it = fs::recursive_directory_iterator(d); it != fs::recursive_directory_iterator();
+         ++it) {
       const fs::path p = it->path();
-      if (it->is_directory() && (p.filename() == "jobs" || p.filename() == "lumps" || p.filename() == "case" ||
-                                 p.filename() == "run" || p.filename().string().rfind("processor", 0) == 0)) {
+      if (it->is_directory() &&
+          (p.filename() == "jobs" || p.filename() == "lumps" || p.filename() == "case" ||
+           p.filename() == "run" || p.filename().string().rfind("processor", 0) == 0)) {
         it.disable_recursion_pending();
         continue;
       }
       const std::string ext = p.extension().string();
-      if (it->is_regular_file() && (ext == ".png" || ext == ".json" || ext == ".csv" || ext == ".md"))
+      if (it->is_regular_file() &&
+          (ext == ".png" || ext == ".json" || ext == ".csv" || ext == ".md"))
         files.push_back(p);
     }
   }
@@ -52,24 +55,24 @@ std::vector<fs::path> report_inputs(const fs::path& run) {
 
 // The stage's figures first in the order an engineer reads them, then the rest.
 int figure_rank(const fs::path& f) {
-  static const std::vector<std::string> first = {"jk_t10_vs_ecs.png",
-                                                 "passing_vs_size.png",
-                                                 "product_vs_rpm.png",
-                                                 "largest_vs_velocity.png",
-                                                 "pieces_vs_velocity.png",
-                                                 "comminution_efficiency_vs_velocity.png",
-                                                 "energy_ledger_fastest.png"};
+  static const std::vector<std::string> first = {
+      "jk_t10_vs_ecs.png",        "passing_vs_size.png",
+      "product_vs_rpm.png",       "largest_vs_velocity.png",
+      "pieces_vs_velocity.png",   "comminution_efficiency_vs_velocity.png",
+      "energy_ledger_fastest.png"};
   const auto it = std::find(first.begin(), first.end(), f.filename().string());
   return it == first.end() ? static_cast<int>(first.size()) : static_cast<int>(it - first.begin());
 }
 
 // The headline rows of the stage's groups as a labelled list (dt/dd).
-void stage_numbers(std::ostringstream& o, const std::vector<report::HeadlineRow>& rows, const std::string& stage) {
+void stage_numbers(std::ostringstream& o, const std::vector<report::HeadlineRow>& rows,
+                   const std::string& stage) {
   std::string items;
   for (const auto& g : report::headline_groups()) {
     if (g.stage != stage) continue;
     for (const auto& r : rows)
-      if (r.group == g.title) items += "<dt>" + esc(r.what) + "</dt><dd>" + esc(r.value) + "</dd>\n";
+      if (r.group == g.title)
+        items += "<dt>" + esc(r.what) + "</dt><dd>" + esc(r.value) + "</dd>\n";
   }
   if (!items.empty()) o << "<dl class=numbers>\n" << items << "</dl>\n";
 }
@@ -102,75 +105,55 @@ void size_table(std::ostringstream& o, const nlohmann::json& sd) {
     if (v.is_number()) return cell(v.get<double>(), "{:.3g}");
     return finest.is_number() ? fmt::format("&lt; {:.3g}", finest.get<double>()) : std::string("-");
   };
-  o << "<table><tr><th>impact speed [m/s]</th><th>angle [deg]</th><th>repeats</th><th>P50 [mm]</th><th>P80 [mm]</th>"
+  o << "<table><tr><th>impact speed [m/s]</th><th>angle [deg]</th><th>repeats</th><th>P50 "
+       "[mm]</th><th>P80 [mm]</th>"
        "<th>P80 over repeats [mm]</th></tr>\n";
   for (const auto& c : conds) {
     const auto r = report::pick(c, "p80_mm_over_repeats");
-    o << fmt::format("<tr><td>{:g}</td><td>{:g}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
-                     c.value("velocity_m_s", 0.0), c.value("angle_deg", 0.0), c.value("repeats", 0),
-                     mm(report::pick(c, "p50_mm")), mm(report::pick(c, "p80_mm")),
-                     r.is_object() ? fmt::format("{:.3g}-{:.3g}", r.value("min", 0.0), r.value("max", 0.0)) : "-");
+    o << fmt::format(
+        "<tr><td>{:g}</td><td>{:g}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+        c.value("velocity_m_s", 0.0), c.value("angle_deg", 0.0), c.value("repeats", 0),
+        mm(report::pick(c, "p50_mm")), mm(report::pick(c, "p80_mm")),
+        r.is_object() ? fmt::format("{:.3g}-{:.3g}", r.value("min", 0.0), r.value("max", 0.0))
+                      : "-");
   }
   o << "</table><p class=note>Sizes are d/D x the lump diameter ("
-    << fmt::format("{:g}", report::pick(sd, "lump_diameter_mm").is_number() ? sd["lump_diameter_mm"].get<double>() : 0.0)
+    << fmt::format("{:g}", report::pick(sd, "lump_diameter_mm").is_number()
+                               ? sd["lump_diameter_mm"].get<double>()
+                               : 0.0)
     << " mm); P50 and P80 are interpolated log-linearly between sieves.</p>\n";
 }
 
-}  // namespace
-
-Plan ReportStage::plan(const StageContext& ctx) const {
-  Plan p;
-  // The report is rebuilt whenever any file it reads changed (size, time).
-  nlohmann::json in = nlohmann::json::array();
-  for (const auto& f : report_inputs(ctx.run_dir)) {
-    struct stat st {};
-    stat(f.c_str(), &st);
-    in.push_back({fs::relative(f, ctx.run_dir).string(), static_cast<long long>(st.st_size),
-                  static_cast<long long>(st.st_mtime)});
-  }
-  p.jobs.push_back({"report", {{"inputs", in}, {"report_version", 4}},
-                    "report/index.html and report/summary.json from every stage's outputs"});
-  return p;
-}
-
-// report/index.html (complete: it ends with </html>) and report/summary.json.
-std::string ReportStage::damaged_outputs(const StageContext& ctx, const JobSpec&) const {
-  return jobs::first_problem({jobs::check_text_ends(ctx.stage_dir / "index.html", "</html>"),
-                              jobs::check_json(ctx.stage_dir / "summary.json")});
-}
-
-void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
+// Figures drawn for the report from the flow stage's files: the mill
+// geometry and the solver's convergence (matplotlib, Debian's python3), into
+// report/figures/ (emptied first). Returns that folder.
+fs::path draw_figures(StageContext& ctx) {
   const fs::path run = ctx.run_dir, out_dir = ctx.stage_dir;
-  const auto inputs = report_inputs(run);
-  Problems problems;
-  nlohmann::json summary = {
-      {"case", ctx.cfg.name}, {"ore", ctx.cfg.ore.str("name")}, {"headline", report::headline_json(run, &problems)}};
-  const auto rows = report::headline_rows(summary["headline"]);
-
-  // Figures drawn for the report from the flow stage's files: the mill
-  // geometry and the solver's convergence (matplotlib, Debian's python3).
   const fs::path figures = out_dir / "figures";
   fs::remove_all(figures);
   if (fs::is_directory(run / "flow")) {
     fs::create_directories(figures);
-    engine::Command c;
-    c.argv = {"/usr/bin/python3", (ctx.cfg.project_dir / "postprocess" / "plot_report_figures.py").string(), "--run",
-              run.string(), "--out", figures.string(), "--target",
-              fmt::format("{:g}", ctx.cfg.doc.real("flow.residual_target"))};
-    c.cwd = out_dir;
-    c.log = out_dir / "figures.log";
-    c.job = "report/figures";
-    ctx.runner.run(c);
+    engine::run_python(ctx.runner, ctx.cfg.project_dir / "postprocess" / "plot_report_figures.py",
+                       {"--run", run.string(), "--out", figures.string(), "--target",
+                        fmt::format("{:g}", ctx.cfg.doc.real("flow.residual_target"))},
+                       out_dir / "figures.log", "report/figures");
   }
-  std::ostringstream o;
-  o << report::page_head("Beater mill: " + ctx.cfg.name);
-  o << "<h1>Beater mill: case " << esc(ctx.cfg.name) << "</h1>\n";
-  if (ctx.cfg.doc.has("description")) o << "<p>" << esc(ctx.cfg.doc.str("description")) << "</p>\n";
-  o << "<p class=note>Case file <code>" << esc(ctx.cfg.file.string()) << "</code>, ore card <code>"
-    << esc(ctx.cfg.ore_file.string()) << "</code>. Every figure is embedded; its data file is linked.</p>\n";
+  return figures;
+}
 
-  // A flow that missed its residual target reaches here only with
-  // flow.allow_unconverged: say so first.
+// The page's head, title, the case's description and where it came from.
+void page_intro(std::ostringstream& o, const config::CaseConfig& cfg) {
+  o << report::page_head("Beater mill: " + cfg.name);
+  o << "<h1>Beater mill: case " << esc(cfg.name) << "</h1>\n";
+  if (cfg.doc.has("description")) o << "<p>" << esc(cfg.doc.str("description")) << "</p>\n";
+  o << "<p class=note>Case file <code>" << esc(cfg.file.string()) << "</code>, ore card <code>"
+    << esc(cfg.ore_file.string())
+    << "</code>. Every figure is embedded; its data file is linked.</p>\n";
+}
+
+// A flow that missed its residual target reaches here only with
+// flow.allow_unconverged: say so first (and in summary.json).
+void unconverged_banner(std::ostringstream& o, nlohmann::json& summary) {
   std::vector<std::string> unconverged;
   const nlohmann::json& head = summary["headline"];
   if (head.contains("flow") && head["flow"].is_object())
@@ -185,142 +168,229 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
       if (it->is_object() && it->contains("flow_converged") && it->at("flow_converged") == false &&
           std::find(unconverged.begin(), unconverged.end(), it.key()) == unconverged.end())
         unconverged.push_back(it.key());
-  if (!unconverged.empty()) {
-    std::string list;
-    for (const auto& r : unconverged) list += (list.empty() ? "" : ", ") + r;
-    o << "<div class=bad><b>The gas flow did not converge</b> (" << esc(list)
-      << "): it missed <code>flow.residual_target</code> within <code>flow.max_iterations</code>, and "
-         "the case sets <code>flow.allow_unconverged: true</code>, so the sampled field, the lump "
-         "tracks, the impact conditions and the mill product below rest on an unconverged flow.</div>\n";
-    summary["unconverged_flow"] = unconverged;
-  }
+  if (unconverged.empty()) return;
+  std::string list;
+  for (const auto& r : unconverged) list += (list.empty() ? "" : ", ") + r;
+  o << "<div class=bad><b>The gas flow did not converge</b> (" << esc(list)
+    << "): it missed <code>flow.residual_target</code> within <code>flow.max_iterations</code>, "
+       "and "
+       "the case sets <code>flow.allow_unconverged: true</code>, so the sampled field, the lump "
+       "tracks, the impact conditions and the mill product below rest on an unconverged "
+       "flow.</div>\n";
+  summary["unconverged_flow"] = unconverged;
+}
 
-  // The headline: a short table in words and units, grouped by stage.
+// The headline: a short table in words and units, grouped by stage.
+void headline_table(std::ostringstream& o, const std::vector<report::HeadlineRow>& rows) {
   o << "<h2>Headline</h2>\n";
   if (rows.empty()) {
     o << "<p class=note>No stage has produced results yet.</p>\n";
-  } else {
-    o << "<table class=headline>\n";
-    std::string group;
-    for (const auto& r : rows) {
-      if (!r.brief) continue;  // shown in its stage's section
-      if (r.group != group) o << "<tr class=group><th colspan=2>" << esc(r.group) << "</th></tr>\n";
-      group = r.group;
-      o << "<tr><td>" << esc(r.what) << "</td><td>" << esc(r.value) << "</td></tr>\n";
-    }
-    o << "</table>\n";
+    return;
   }
+  o << "<table class=headline>\n";
+  std::string group;
+  for (const auto& r : rows) {
+    if (!r.brief) continue;  // shown in its stage's section
+    if (r.group != group) o << "<tr class=group><th colspan=2>" << esc(r.group) << "</th></tr>\n";
+    group = r.group;
+    o << "<tr><td>" << esc(r.what) << "</td><td>" << esc(r.value) << "</td></tr>\n";
+  }
+  o << "</table>\n";
+}
 
+// The case's section: the mill's picture, the ore card, every key folded.
+void case_section(std::ostringstream& o, const config::CaseConfig& cfg, const fs::path& figures) {
   o << "<h2>Case and ore card</h2>\n";
-  if (fs::exists(figures / "mill_geometry.png")) embed_png(o, figures / "mill_geometry.png", "mill geometry (STL)");
-  ore_table(o, ctx.cfg.ore);
-  o << fold("The ore card as written") ;
-  json_table(o, ctx.cfg.ore.to_json());
+  if (fs::exists(figures / "mill_geometry.png"))
+    embed_png(o, figures / "mill_geometry.png", "mill geometry (STL)");
+  ore_table(o, cfg.ore);
+  o << fold("The ore card as written");
+  json_table(o, cfg.ore.to_json());
   o << "</details>\n" << fold("All case keys (defaults included)");
-  json_table(o, ctx.cfg.doc.to_json());
+  json_table(o, cfg.doc.to_json());
   o << "</details>\n";
+}
 
+// What a stage section is drawn from, and where it writes.
+struct SectionInputs {
+  fs::path run, out_dir, figures;
+  const std::vector<report::HeadlineRow>& rows;
+  nlohmann::json& summary;
+  Problems& problems;
+};
+
+// A stage's JSON files as folded tables (into `raw`, each also into
+// summary.json) and links to its data files (JSON, CSV, Markdown) in `o`.
+void stage_data(std::ostringstream& o, std::ostringstream& raw, const std::vector<fs::path>& mine,
+                const SectionInputs& in) {
+  std::string links;
+  for (const auto& f : mine) {
+    const std::string rel = fs::relative(f, in.out_dir).string();
+    const std::string name = fs::relative(f, in.run).string();
+    if (f.extension() == ".json") {
+      const nlohmann::json j = report::read_json(f, &in.problems);
+      if (j.is_null()) {
+        o << "<p class=bad><code>" << esc(name)
+          << "</code> not shown: this file is damaged (see the top of the "
+          << "page).</p>\n";
+        continue;
+      }
+      raw << "<h3>" << esc(name) << "</h3>\n";
+      if (j.is_object())
+        json_table(raw, j);
+      else if (j.is_array())
+        for (const auto& e : j)
+          if (e.is_object()) json_table(raw, e);
+      in.summary[name] = j;
+      links += (links.empty() ? "" : ", ") + std::string("<a href=\"") + esc(rel) + "\">" +
+               esc(name) + "</a>";
+    } else if (f.extension() == ".csv" || f.extension() == ".md") {
+      links += (links.empty() ? "" : ", ") + std::string("<a href=\"") + esc(rel) + "\">" +
+               esc(name) + "</a>";
+    }
+  }
+  if (!links.empty()) o << "<p class=note>Data: " << links << "</p>\n";
+}
+
+// Every impact of breakage/summary.csv as a table (into `raw`).
+void impact_table(std::ostringstream& raw, const SectionInputs& in) {
+  std::vector<post::ImpactSummary> impacts;
+  if (fs::exists(in.run / "breakage" / "summary.csv")) {
+    try {
+      impacts = post::ReadSummaryCsv((in.run / "breakage" / "summary.csv").string());
+    } catch (const std::exception& e) {
+      in.problems.push_back({in.run / "breakage" / "summary.csv", e.what()});
+    }
+  }
+  if (impacts.empty()) return;
+  raw << "<h3>Every impact</h3><table><tr><th>V [m/s]</th><th>angle "
+         "[deg]</th><th>repeat</th><th>pieces</th>"
+         "<th>single</th><th>multi</th><th>largest [%]</th><th>single mass [%]</th><th>broken "
+         "bonds [%]</th>"
+         "<th>Ecs [kWh/t]</th><th>t10 [%]</th><th>comminution efficiency [%]</th></tr>\n";
+  for (const auto& r : impacts)
+    raw << fmt::format(
+        "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</"
+        "td>"
+        "<td>{}</td><td>{}</td><td>{}{}</td><td>{}</td></tr>\n",
+        cell(r.velocity_m_s, "{:g}"), cell(r.angle_deg, "{:g}"), r.repeat, r.n_pieces, r.n_single,
+        r.n_multi, cell(r.largest_mass_fraction, "{:.1f}", 100),
+        cell(r.single_mass_fraction, "{:.1f}", 100), cell(r.broken_bond_fraction, "{:.1f}", 100),
+        cell(r.specific_energy_kWh_t, "{:.3g}"), cell(r.t10_percent, "{:.1f}"),
+        r.t10_resolved ? "" : "*", cell(r.comminution_efficiency, "{:.3g}", 100));
+  raw << "</table><p class=note>* t10 not resolved: single elements are coarser than a tenth of "
+         "the lump.</p>\n";
+  in.summary["breakage_impacts"] = impacts.size();
+}
+
+// One stage's section: figures first, then the stage's labelled numbers,
+// then the raw data folded; a note when the stage has not run.
+void stage_section(std::ostringstream& o, const std::string& stage, const std::string& title,
+                   const std::vector<fs::path>& inputs, const SectionInputs& in) {
+  std::vector<fs::path> mine;
+  for (const auto& f : inputs)
+    if (fs::relative(f, in.run).begin()->string() == stage) mine.push_back(f);
+  o << "<h2>" << esc(title) << "</h2>\n";
+  if (stage == "flow" && fs::is_directory(in.figures))
+    for (const auto& f : fs::directory_iterator(in.figures))
+      if (f.path().filename().string().rfind("flow_convergence_", 0) == 0)
+        embed_png(o, f.path(), "solver convergence, " + f.path().stem().string().substr(17));
+  if (mine.empty()) {
+    o << "<p class=note>No results: stage '" << stage << "' has not run (<code>orchestrate --stage "
+      << stage << "</code>).</p>\n";
+    return;
+  }
+  std::vector<fs::path> pngs;
+  for (const auto& f : mine)
+    if (f.extension() == ".png") pngs.push_back(f);
+  std::stable_sort(pngs.begin(), pngs.end(), [](const fs::path& a, const fs::path& b) {
+    return figure_rank(a) < figure_rank(b);
+  });
+  for (const auto& f : pngs) embed_png(o, f, fs::relative(f, in.run).string());
+  stage_numbers(o, in.rows, stage);
+  if (stage == "breakage")
+    size_table(o, report::read_json(in.run / "breakage" / "size_distributions.json", &in.problems));
+  std::ostringstream raw;
+  stage_data(o, raw, mine, in);
+  if (stage == "breakage") impact_table(raw, in);
+  if (!raw.str().empty())
+    o << fold("Raw results: every key of the stage's JSON files") << raw.str() << "</details>\n";
+}
+
+// Damaged input files: named at the top of the page (before the headline),
+// in summary.json and on the console.
+void damaged_box(StageContext& ctx, std::ostringstream& o, const Problems& problems,
+                 nlohmann::json& summary) {
+  if (problems.empty()) return;
+  std::ostringstream box;
+  box << "<div class=bad><b>Damaged input files, left out of this report:</b><ul>\n";
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& [f, why] : problems) {
+    const std::string rel = fs::relative(f, ctx.run_dir).string();
+    box << "<li><code>" << esc(rel) << "</code>: " << esc(why) << "</li>\n";
+    list.push_back({{"file", rel}, {"problem", why}});
+    ctx.progress.warn(
+        fmt::format("[report] {}: {}; left out of the report (rerun the stage that writes it, with "
+                    "--force if its jobs are done)",
+                    f.string(), why));
+  }
+  box << "</ul>Rerun the stage that writes each file (with <code>--force</code> if its jobs are "
+         "done), then the "
+         "report.</div>\n";
+  summary["damaged_inputs"] = list;
+  std::string page = o.str();
+  page.insert(page.find("<h2>Headline</h2>"), box.str());
+  o.str(page);
+  o.seekp(0, std::ios::end);
+}
+
+}  // namespace
+
+Plan ReportStage::plan(const StageContext& ctx) const {
+  Plan p;
+  // The report is rebuilt whenever any file it reads changed (size, time).
+  nlohmann::json in = nlohmann::json::array();
+  for (const auto& f : report_inputs(ctx.run_dir)) {
+    struct stat st {};
+    stat(f.c_str(), &st);
+    in.push_back({fs::relative(f, ctx.run_dir).string(), static_cast<long long>(st.st_size),
+                  static_cast<long long>(st.st_mtime)});
+  }
+  p.jobs.push_back({"report",
+                    {{"inputs", in}, {"report_version", 4}},
+                    "report/index.html and report/summary.json from every stage's outputs"});
+  return p;
+}
+
+// report/index.html (complete: it ends with </html>) and report/summary.json.
+std::string ReportStage::damaged_outputs(const StageContext& ctx, const JobSpec&) const {
+  return jobs::first_problem({jobs::check_text_ends(ctx.stage_dir / "index.html", "</html>"),
+                              jobs::check_json(ctx.stage_dir / "summary.json")});
+}
+
+void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
+  const fs::path run = ctx.run_dir, out_dir = ctx.stage_dir;
+  const auto inputs = report_inputs(run);
+  Problems problems;
+  nlohmann::json summary = {{"case", ctx.cfg.name},
+                            {"ore", ctx.cfg.ore.str("name")},
+                            {"headline", report::headline_json(run, &problems)}};
+  const auto rows = report::headline_rows(summary["headline"]);
+  const fs::path figures = draw_figures(ctx);
+  std::ostringstream o;
+  page_intro(o, ctx.cfg);
+  unconverged_banner(o, summary);
+  headline_table(o, rows);
+  case_section(o, ctx.cfg, figures);
   const std::vector<std::pair<std::string, std::string>> sections = {
       {"flow", "Stage 1a: gas flow (OpenFOAM)"},
       {"sample", "Stage 1a: sampled velocity field"},
       {"transport", "Stage 1b: ore lumps through the mill"},
       {"calibrate", "Calibration of the bond model"},
       {"breakage", "Stage 2: breakage of one lump"}};
-  for (const auto& [stage, title] : sections) {
-    std::vector<fs::path> mine;
-    for (const auto& f : inputs)
-      if (fs::relative(f, run).begin()->string() == stage) mine.push_back(f);
-    o << "<h2>" << esc(title) << "</h2>\n";
-    // Figures first, then the stage's labelled numbers, then the raw data folded.
-    if (stage == "flow" && fs::is_directory(figures))
-      for (const auto& f : fs::directory_iterator(figures))
-        if (f.path().filename().string().rfind("flow_convergence_", 0) == 0)
-          embed_png(o, f.path(), "solver convergence, " + f.path().stem().string().substr(17));
-    if (mine.empty()) {
-      o << "<p class=note>No results: stage '" << stage << "' has not run (<code>orchestrate --stage " << stage
-        << "</code>).</p>\n";
-      continue;
-    }
-    std::vector<fs::path> pngs;
-    for (const auto& f : mine)
-      if (f.extension() == ".png") pngs.push_back(f);
-    std::stable_sort(pngs.begin(), pngs.end(),
-                     [](const fs::path& a, const fs::path& b) { return figure_rank(a) < figure_rank(b); });
-    for (const auto& f : pngs) embed_png(o, f, fs::relative(f, run).string());
-    stage_numbers(o, rows, stage);
-    if (stage == "breakage")
-      size_table(o, report::read_json(run / "breakage" / "size_distributions.json", &problems));
-
-    std::ostringstream raw;
-    std::string links;
-    for (const auto& f : mine) {
-      const std::string rel = fs::relative(f, out_dir).string();
-      const std::string name = fs::relative(f, run).string();
-      if (f.extension() == ".json") {
-        const nlohmann::json j = report::read_json(f, &problems);
-        if (j.is_null()) {
-          o << "<p class=bad><code>" << esc(name) << "</code> not shown: this file is damaged (see the top of the "
-            << "page).</p>\n";
-          continue;
-        }
-        raw << "<h3>" << esc(name) << "</h3>\n";
-        if (j.is_object()) json_table(raw, j);
-        else if (j.is_array())
-          for (const auto& e : j)
-            if (e.is_object()) json_table(raw, e);
-        summary[name] = j;
-        links += (links.empty() ? "" : ", ") + std::string("<a href=\"") + esc(rel) + "\">" + esc(name) + "</a>";
-      } else if (f.extension() == ".csv" || f.extension() == ".md") {
-        links += (links.empty() ? "" : ", ") + std::string("<a href=\"") + esc(rel) + "\">" + esc(name) + "</a>";
-      }
-    }
-    if (!links.empty()) o << "<p class=note>Data: " << links << "</p>\n";
-    std::vector<post::ImpactSummary> impacts;
-    if (stage == "breakage" && fs::exists(run / "breakage" / "summary.csv")) {
-      try {
-        impacts = post::ReadSummaryCsv((run / "breakage" / "summary.csv").string());
-      } catch (const std::exception& e) {
-        problems.push_back({run / "breakage" / "summary.csv", e.what()});
-      }
-    }
-    if (!impacts.empty()) {
-      raw << "<h3>Every impact</h3><table><tr><th>V [m/s]</th><th>angle [deg]</th><th>repeat</th><th>pieces</th>"
-             "<th>single</th><th>multi</th><th>largest [%]</th><th>single mass [%]</th><th>broken bonds [%]</th>"
-             "<th>Ecs [kWh/t]</th><th>t10 [%]</th><th>comminution efficiency [%]</th></tr>\n";
-      for (const auto& r : impacts)
-        raw << fmt::format(
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>"
-            "<td>{}</td><td>{}</td><td>{}{}</td><td>{}</td></tr>\n",
-            cell(r.velocity_m_s, "{:g}"), cell(r.angle_deg, "{:g}"), r.repeat, r.n_pieces, r.n_single, r.n_multi,
-            cell(r.largest_mass_fraction, "{:.1f}", 100), cell(r.single_mass_fraction, "{:.1f}", 100),
-            cell(r.broken_bond_fraction, "{:.1f}", 100), cell(r.specific_energy_kWh_t, "{:.3g}"),
-            cell(r.t10_percent, "{:.1f}"), r.t10_resolved ? "" : "*", cell(r.comminution_efficiency, "{:.3g}", 100));
-      raw << "</table><p class=note>* t10 not resolved: single elements are coarser than a tenth of the lump.</p>\n";
-      summary["breakage_impacts"] = impacts.size();
-    }
-    if (!raw.str().empty()) o << fold("Raw results: every key of the stage's JSON files") << raw.str() << "</details>\n";
-  }
-  if (!problems.empty()) {
-    // Named at the top of the page, in summary.json and on the console.
-    std::ostringstream box;
-    box << "<div class=bad><b>Damaged input files, left out of this report:</b><ul>\n";
-    nlohmann::json list = nlohmann::json::array();
-    for (const auto& [f, why] : problems) {
-      const std::string rel = fs::relative(f, run).string();
-      box << "<li><code>" << esc(rel) << "</code>: " << esc(why) << "</li>\n";
-      list.push_back({{"file", rel}, {"problem", why}});
-      ctx.progress.warn(fmt::format("[report] {}: {}; left out of the report (rerun the stage that writes it, with "
-                                    "--force if its jobs are done)",
-                                    f.string(), why));
-    }
-    box << "</ul>Rerun the stage that writes each file (with <code>--force</code> if its jobs are done), then the "
-           "report.</div>\n";
-    summary["damaged_inputs"] = list;
-    std::string page = o.str();
-    page.insert(page.find("<h2>Headline</h2>"), box.str());
-    o.str(page);
-    o.seekp(0, std::ios::end);
-  }
+  const SectionInputs in{run, out_dir, figures, rows, summary, problems};
+  for (const auto& [stage, title] : sections) stage_section(o, stage, title, inputs, in);
+  damaged_box(ctx, o, problems, summary);
   o << report::page_tail();
   jobs::atomic_write(out_dir / "index.html", o.str());
   jobs::atomic_write(out_dir / "summary.json", summary.dump(2) + "\n");

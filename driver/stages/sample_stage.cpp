@@ -17,6 +17,7 @@
 #include <vtkUnsignedCharArray.h>
 #include <vtkXMLImageDataWriter.h>
 
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <regex>
@@ -107,8 +108,12 @@ post::FlowField make_grid(const GridSpec& g) {
   return f;
 }
 
-// vtkOpenFOAMReader -> vtkResampleToImage -> FlowField.
-post::FlowField resample_case(const fs::path& case_dir, const GridSpec& grid, const Options& opt) {
+namespace {
+
+// The case's reader on its internal mesh with the cell fields the sampler
+// needs (U; rho, or p and T, unless the density is constant; k and omega with
+// opt.turbulence) and `t`, its latest time. Throws naming a missing field.
+Ptr<vtkOpenFOAMReader> open_case(const fs::path& case_dir, const Options& opt, double& t) {
   const fs::path foam = case_dir / "case.foam";
   if (!fs::exists(case_dir / "constant" / "polyMesh"))
     throw std::runtime_error(
@@ -134,8 +139,7 @@ post::FlowField resample_case(const fs::path& case_dir, const GridSpec& grid, co
     return false;
   };
   std::vector<std::string> want{"U"};
-  const bool read_rho = opt.constant_rho <= 0;
-  if (read_rho) {
+  if (opt.constant_rho <= 0) {
     if (has_cell_array("rho"))
       want.push_back("rho");
     else
@@ -150,71 +154,78 @@ post::FlowField resample_case(const fs::path& case_dir, const GridSpec& grid, co
     reader->SetCellArrayStatus(w.c_str(), 1);
   }
   vtkDoubleArray* times = reader->GetTimeValues();
-  const double t = (times && times->GetNumberOfTuples() > 0)
-                       ? times->GetValue(times->GetNumberOfTuples() - 1)
-                       : 0.0;
+  t = (times && times->GetNumberOfTuples() > 0) ? times->GetValue(times->GetNumberOfTuples() - 1)
+                                                : 0.0;
+  return reader;
+}
 
-  const post::FlowField full = make_grid(grid);
-  // Half-domain case (flow.domain = half): the mesh covers z >= 0 only. Probe
-  // the planes k >= k0 of the grid (z >= 0; the grid is symmetric about z = 0
-  // because the box is) and fill the planes k < k0 by reflection below.
-  const bool mirror = half_domain_case(case_dir);
-  int k0 = 0;
+// The grid planes a case is probed on. Half-domain case (flow.domain = half):
+// the mesh covers z >= 0 only, so the planes k >= k0 of the grid are probed
+// (z >= 0; the grid is symmetric about z = 0 because the box is) and the
+// planes k < k0 filled by reflection afterwards.
+struct ProbedPlanes {
+  post::FlowField full;  // the whole grid
+  post::FlowField f;     // the probed planes k0 .. nz-1
+  bool mirror = false;
   bool on_plane = false;  // grid plane k0 lies on the symmetry plane z = 0
-  if (mirror) {
+};
+
+ProbedPlanes probed_planes(const fs::path& case_dir, const GridSpec& grid) {
+  ProbedPlanes p;
+  p.full = make_grid(grid);
+  p.mirror = half_domain_case(case_dir);
+  int k0 = 0;
+  if (p.mirror) {
     const double L = grid.hi[2] - grid.lo[2];
     if (std::abs(grid.lo[2] + grid.hi[2]) > 1e-9 * L)
       throw std::invalid_argument(fmt::format(
           "{}: a half-domain case is mirrored about z = 0, but the sampling box z {:g} .. {:g} "
           "is not symmetric about it",
           case_dir.string(), grid.lo[2], grid.hi[2]));
-    k0 = full.dims[2] / 2;  // odd nz: the plane z = 0; even nz: the first plane z > 0
-    on_plane = full.dims[2] % 2 == 1;
+    k0 = p.full.dims[2] / 2;  // odd nz: the plane z = 0; even nz: the first plane z > 0
+    p.on_plane = p.full.dims[2] % 2 == 1;
   }
-  post::FlowField f = full;  // the probed planes k0 .. nz-1
-  f.dims[2] = full.dims[2] - k0;
-  f.origin[2] = full.origin[2] + k0 * full.spacing[2];
-  // Probe on one thread: with VTK's threaded backend each thread keeps its own
-  // cell-search hint, so a grid point on a face shared by two cells took the
-  // value of either cell depending on thread timing (runs differed by up to
-  // 0.4 m/s on the tiny mesh, and the transport stage amplified it).
-  vtkSMPTools::SetBackend("Sequential");
-  auto rs = Ptr<vtkResampleToImage>::New();
-  rs->SetInputConnection(reader->GetOutputPort());
-  rs->SetUseInputBounds(false);
-  // Probe slightly inside the nominal box: points exactly on the housing walls
-  // would otherwise fall in or out of the mesh by round-off, and snapping
-  // moves wall points by a fraction of a millimetre (see grid.wall_inset).
-  double b[6];
+  p.f = p.full;
+  p.f.dims[2] = p.full.dims[2] - k0;
+  p.f.origin[2] = p.full.origin[2] + k0 * p.full.spacing[2];
+  return p;
+}
+
+// The box the resampler probes, slightly inside the nominal one: points
+// exactly on the housing walls would otherwise fall in or out of the mesh by
+// round-off, and snapping moves wall points by a fraction of a millimetre
+// (see grid.wall_inset).
+std::array<double, 6> sampling_bounds(const ProbedPlanes& p, const GridSpec& grid) {
+  const post::FlowField& f = p.f;
+  std::array<double, 6> b{};
   for (int d = 0; d < 3; ++d) {
     const double e = std::max(1e-6 * f.spacing[d], grid.wall_inset);
     b[2 * d] = f.origin[d] + e;
     b[2 * d + 1] = f.origin[d] + (f.dims[d] - 1) * f.spacing[d] - e;
   }
-  if (mirror) {
+  if (p.mirror) {
     // The symmetry plane is a mesh boundary like the walls: probe the grid
     // plane lying on it just inside the half mesh; other planes as usual.
     const double e = std::max(1e-6 * f.spacing[2], grid.wall_inset);
-    b[4] = f.origin[2] + (on_plane ? e : 0.0);
+    b[4] = f.origin[2] + (p.on_plane ? e : 0.0);
     if (f.dims[2] == 1) b[4] = b[5];
   }
-  rs->SetSamplingBounds(b);
-  rs->SetSamplingDimensions(f.dims[0], f.dims[1], f.dims[2]);
-  rs->UpdateTimeStep(t);
-  vtkImageData* img = rs->GetOutput();
-  if (!img || img->GetNumberOfPoints() != static_cast<vtkIdType>(f.size()))
-    throw std::runtime_error(fmt::format("{}: resampling produced no grid", case_dir.string()));
+  return b;
+}
 
+// The resampled point data into f: the mask, U, the density (constant, the
+// case's rho, or p / (R T)) and, with opt.turbulence, k and omega.
+void take_fields(post::FlowField& f, vtkPointData* pd, const char* mask_name, const Options& opt,
+                 const fs::path& case_dir) {
   f.allocate(opt.turbulence);
-  vtkPointData* pd = img->GetPointData();
-  vtkDataArray* valid = pd->GetArray(rs->GetMaskArrayName());
+  vtkDataArray* valid = pd->GetArray(mask_name);
   vtkDataArray* U = pd->GetArray("U");
   if (!valid || !U)
     throw std::runtime_error(
         fmt::format("{}: resampled grid lacks U or the mask", case_dir.string()));
   for (size_t i = 0; i < f.size(); ++i) f.mask[i] = valid->GetComponent(i, 0) > 0.5 ? 1 : 0;
   take(U, 3, f.mask, f.U);
-  if (!read_rho) {
+  if (opt.constant_rho > 0) {
     for (size_t i = 0; i < f.size(); ++i) f.rho[i] = f.mask[i] ? opt.constant_rho : 0.0;
   } else if (vtkDataArray* r = pd->GetArray("rho")) {
     take(r, 1, f.mask, f.rho);
@@ -228,13 +239,39 @@ post::FlowField resample_case(const fs::path& case_dir, const GridSpec& grid, co
     take(pd->GetArray("k"), 1, f.mask, f.k);
     take(pd->GetArray("omega"), 1, f.mask, f.omega);
   }
+}
+
+}  // namespace
+
+// vtkOpenFOAMReader -> vtkResampleToImage -> FlowField.
+post::FlowField resample_case(const fs::path& case_dir, const GridSpec& grid, const Options& opt) {
+  double t = 0;
+  const auto reader = open_case(case_dir, opt, t);
+  ProbedPlanes p = probed_planes(case_dir, grid);
+  post::FlowField& f = p.f;
+  // Probe on one thread: with VTK's threaded backend each thread keeps its own
+  // cell-search hint, so a grid point on a face shared by two cells took the
+  // value of either cell depending on thread timing (runs differed by up to
+  // 0.4 m/s on the tiny mesh, and the transport stage amplified it).
+  vtkSMPTools::SetBackend("Sequential");
+  auto rs = Ptr<vtkResampleToImage>::New();
+  rs->SetInputConnection(reader->GetOutputPort());
+  rs->SetUseInputBounds(false);
+  std::array<double, 6> b = sampling_bounds(p, grid);
+  rs->SetSamplingBounds(b.data());
+  rs->SetSamplingDimensions(f.dims[0], f.dims[1], f.dims[2]);
+  rs->UpdateTimeStep(t);
+  vtkImageData* img = rs->GetOutput();
+  if (!img || img->GetNumberOfPoints() != static_cast<vtkIdType>(f.size()))
+    throw std::runtime_error(fmt::format("{}: resampling produced no grid", case_dir.string()));
+  take_fields(f, img->GetPointData(), rs->GetMaskArrayName(), opt, case_dir);
   f.source =
       fmt::format("{} (time {:g}), vtkOpenFOAMReader + vtkResampleToImage", case_dir.string(), t);
-  if (!mirror) return f;
-  if (on_plane)  // the symmetry plane's condition: no flow through it
+  if (!p.mirror) return std::move(f);
+  if (p.on_plane)  // the symmetry plane's condition: no flow through it
     for (int j = 0; j < f.dims[1]; ++j)
       for (int i = 0; i < f.dims[0]; ++i) f.U[3 * f.point(i, j, 0) + 2] = 0.0;
-  return mirror_z(f, full.dims[2]);
+  return mirror_z(f, p.full.dims[2]);
 }
 
 // FlowField -> vtkImageData -> XML (.vti, binary appended, compressed).
@@ -348,8 +385,9 @@ Plan SampleStage::plan(const StageContext& ctx) const {
 // sample/<label>/{field.h5, field.vti, midplane_speed.png, sample_report.json}.
 std::string SampleStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
   const fs::path out = ctx.stage_dir / job.label;
-  return jobs::first_problem({jobs::check_json(out / "sample_report.json"), jobs::check_hdf5(out / "field.h5"),
-                              jobs::check_file(out / "field.vti"), jobs::check_file(out / "midplane_speed.png")});
+  return jobs::first_problem(
+      {jobs::check_json(out / "sample_report.json"), jobs::check_hdf5(out / "field.h5"),
+       jobs::check_file(out / "field.vti"), jobs::check_file(out / "midplane_speed.png")});
 }
 
 // flow/<label>/case -> sample/<label>/{field.h5, field.vti, midplane_speed.png}.
@@ -431,23 +469,24 @@ void SampleStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path&
   post::write_flow_field(tmp / "field.h5", f);
   sample::write_vti(tmp / "field.vti", f);
   const auto range = sample::write_midplane_png(tmp / "midplane_speed.png", f, 0.0);
-  nlohmann::json rep = {{"rpm", f.rpm},
-                        {"dims", f.dims},
-                        {"origin_m", f.origin},
-                        {"spacing_m", f.spacing},
-                        {"points", f.size()},
-                        {"gas_points", gas},
-                        {"gas_fraction", static_cast<double>(gas) / f.size()},
-                        {"max_speed_m_s", umax},
-                        {"flow_domain", domain},
-                        {"flow_converged", flow_rep.is_object() ? flow_rep.value("converged", true) : true},
-                        {"mirrored_about_z0", mirrored},
-                        {"midplane_png",
-                         {{"file", "midplane_speed.png"},
-                          {"z_m", 0.0},
-                          {"speed_range_m_s", range},
-                          {"colours", "blue (0) to red (max); grey = solid; bar on the right"}}},
-                        {"files", {"field.h5", "field.vti", "midplane_speed.png"}}};
+  nlohmann::json rep = {
+      {"rpm", f.rpm},
+      {"dims", f.dims},
+      {"origin_m", f.origin},
+      {"spacing_m", f.spacing},
+      {"points", f.size()},
+      {"gas_points", gas},
+      {"gas_fraction", static_cast<double>(gas) / f.size()},
+      {"max_speed_m_s", umax},
+      {"flow_domain", domain},
+      {"flow_converged", flow_rep.is_object() ? flow_rep.value("converged", true) : true},
+      {"mirrored_about_z0", mirrored},
+      {"midplane_png",
+       {{"file", "midplane_speed.png"},
+        {"z_m", 0.0},
+        {"speed_range_m_s", range},
+        {"colours", "blue (0) to red (max); grey = solid; bar on the right"}}},
+      {"files", {"field.h5", "field.vti", "midplane_speed.png"}}};
   jobs::atomic_write(tmp / "sample_report.json", rep.dump(2) + "\n");
   fs::remove_all(out);
   fs::rename(tmp, out);

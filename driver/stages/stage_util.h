@@ -14,8 +14,6 @@ namespace mill {
 
 // The case keys under the given prefixes ("mill.", "gas."), as canonical JSON.
 nlohmann::json case_keys(const config::Document& doc, const std::vector<std::string>& prefixes);
-// The ore card's macro properties (everything but name/source/calibrated.*/jk.*).
-nlohmann::json ore_keys(const config::Document& ore);
 // "rpm2000", "rpm1500.5": folder label of a rotor speed.
 std::string rpm_label(double rpm);
 // "v150_a90_r0", "v4.5_a45_r2": folder label of an impact condition.

@@ -253,7 +253,7 @@ Plan TransportStage::plan(const StageContext& ctx) const {
     nlohmann::json in =
         case_keys(ctx.cfg.doc, {"mill.", "gas.", "flow.", "sample.", "injection.", "transport."});
     in["rotor.rpm"] = rpm;
-    in["ore"] = ore_keys(ctx.cfg.ore);
+    in["ore"] = config::ore_keys(ctx.cfg.ore);
     in["deck_version"] = kDeckVersion;
     p.jobs.push_back(
         {rpm_label(rpm), in,
@@ -282,108 +282,176 @@ std::string TransportStage::damaged_outputs(const StageContext& ctx, const JobSp
   return "";
 }
 
-// Runs the lumps through the mill at one rotor speed and writes the results
-// into transport/<label>/ (each file complete or absent).
-void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& job_dir) {
-  const auto& d = ctx.cfg.doc;
-  const double rpm = job.inputs.at("rotor.rpm").get<double>();
-  const std::string label = job.label;
+namespace {
+
+// The sampled gas field of the rotor speed, or MissingInput naming the
+// command that makes it.
+fs::path sampled_field(const StageContext& ctx, const std::string& label, double rpm) {
   const fs::path field_file = ctx.run_dir / "sample" / label / "field.h5";
   if (!fs::exists(field_file))
     throw MissingInput(fmt::format(
         "stage transport ({}) needs {} (the sampled gas field at {:g} rpm); make it with "
         "`orchestrate --case {} --stage sample --output {}` (after --stage flow)",
-        label, field_file.string(), rpm, d.file(), ctx.run_dir.string()));
-  const nlohmann::json flow_converged = check_flow_converged(ctx, label);
-  // injection.time_limit > duration and the time step: checked with the case.
-  const double duration = d.real("injection.duration"), t_limit = d.real("injection.time_limit");
-  const geometry::MillGeometry g = geometry::MillGeometry::from_config(d);
-  const double omega = rpm * 2 * kPi / 60.0;
-  const long n = d.integer("injection.n_lumps");
-  const double diameter = d.real("injection.lump_diameter"), dt = d.real("injection.timestep");
-  const double density = ctx.cfg.ore.real("density");
+        label, field_file.string(), rpm, ctx.cfg.doc.file(), ctx.run_dir.string()));
+  return field_file;
+}
 
-  const fs::path work = job_dir / "run";
-  fs::remove_all(work);
-  fs::create_directories(work);
-  const geometry::StlSet stl = geometry::write_stl_set(g, work / "stl");
-  const post::FlowField field = post::read_flow_field(field_file);
-  std::vector<std::string> notes;
-  const std::vector<Lump> lumps = injection_schedule(g, field, n, diameter, duration, notes);
-  for (const auto& s : notes) ctx.progress.warn(fmt::format("transport {}: {}", label, s));
-  jobs::atomic_write(work / "insert.in", insert_commands(lumps, diameter, density, dt));
+// What one transport run shares between its steps: the settings, the mill,
+// the lumps injected, and what the deck left (end.txt, wall time).
+struct TransportRun {
+  std::string label;
+  double rpm = 0, omega = 0;         // 1/min, rad/s
+  double diameter = 0, density = 0;  // the lumps', m and kg/m^3
+  double dt = 0;                     // s
+  geometry::MillGeometry g;
+  fs::path field_file, work;
+  std::vector<Lump> lumps;
+  std::array<double, 4> end{};  // end time, remaining, exited, masked drag steps
+  double wall_seconds = 0;
+};
 
-  const double margin = std::max(0.05, diameter);
+// The -var pairs of transport.in.tmpl: the mill's STL files and box, the
+// rotor, the gas field, the injection, the output intervals and the ore.
+std::vector<std::pair<std::string, std::string>> transport_vars(const StageContext& ctx,
+                                                                const TransportRun& r,
+                                                                const geometry::StlSet& stl) {
+  const auto& d = ctx.cfg.doc;
+  const geometry::MillGeometry& g = r.g;
+  const double margin = std::max(0.05, r.diameter);
+  const double dt = r.dt;
   const auto steps = [dt](double seconds) {
     return std::to_string(std::max(0LL, std::llround(seconds / dt)));
   };
+  return {{"housing_stl", fs::absolute(stl.housing).string()},
+          {"flywheel_stl", fs::absolute(stl.flywheel).string()},
+          {"outlet_stl", fs::absolute(stl.outlet).string()},
+          {"xlo", num(-0.5 * g.width - margin)},
+          {"xhi", num(0.5 * g.width + margin)},
+          {"ylo", num(-0.3)},
+          {"yhi", num(g.height + margin)},
+          {"zlo", num(-0.5 * g.depth - margin)},
+          {"zhi", num(0.5 * g.depth + margin)},
+          {"axis_x", num(g.axis_x)},
+          {"axis_y", num(g.axis_height)},
+          {"omega", num(r.omega)},
+          {"field_file", fs::absolute(r.field_file).string()},
+          {"viscosity", num(d.real("gas.viscosity"))},
+          {"insert_file", "insert.in"},
+          {"n_lumps", std::to_string(d.integer("injection.n_lumps"))},
+          {"t_limit", num(d.real("injection.time_limit"))},
+          {"dt", num(dt)},
+          {"skin", num(std::max(0.25 * r.diameter, 0.002))},
+          {"traj_every", steps(d.real("transport.trajectory_interval"))},
+          {"vtk_every", steps(d.real("transport.vtk_interval"))},
+          {"density", num(r.density)},
+          {"E", num(ctx.cfg.ore.real("youngs_modulus"))},
+          {"nu", num(ctx.cfg.ore.real("poisson_ratio"))},
+          {"restitution", num(ctx.cfg.ore.real("restitution"))},
+          {"friction", num(ctx.cfg.ore.real("friction"))}};
+}
+
+// Writes the mill and the injection into r.work and runs the deck there.
+void run_transport_deck(StageContext& ctx, TransportRun& r) {
+  const auto& d = ctx.cfg.doc;
+  fs::remove_all(r.work);
+  fs::create_directories(r.work);
+  const geometry::StlSet stl = geometry::write_stl_set(r.g, r.work / "stl");
+  const post::FlowField field = post::read_flow_field(r.field_file);
+  std::vector<std::string> notes;
+  r.lumps = injection_schedule(r.g, field, d.integer("injection.n_lumps"), r.diameter,
+                               d.real("injection.duration"), notes);
+  for (const auto& s : notes) ctx.progress.warn(fmt::format("transport {}: {}", r.label, s));
+  jobs::atomic_write(r.work / "insert.in", insert_commands(r.lumps, r.diameter, r.density, r.dt));
   engine::DeckRun run;
   run.deck = ctx.cfg.project_dir / "liggghts_inputs" / "transport.in.tmpl";
-  run.workdir = work;
+  run.workdir = r.work;
   run.np = ctx.opts.np;
-  run.job = "transport/" + label;
-  run.vars = {{"housing_stl", fs::absolute(stl.housing).string()},
-              {"flywheel_stl", fs::absolute(stl.flywheel).string()},
-              {"outlet_stl", fs::absolute(stl.outlet).string()},
-              {"xlo", num(-0.5 * g.width - margin)},
-              {"xhi", num(0.5 * g.width + margin)},
-              {"ylo", num(-0.3)},
-              {"yhi", num(g.height + margin)},
-              {"zlo", num(-0.5 * g.depth - margin)},
-              {"zhi", num(0.5 * g.depth + margin)},
-              {"axis_x", num(g.axis_x)},
-              {"axis_y", num(g.axis_height)},
-              {"omega", num(omega)},
-              {"field_file", fs::absolute(field_file).string()},
-              {"viscosity", num(d.real("gas.viscosity"))},
-              {"insert_file", "insert.in"},
-              {"n_lumps", std::to_string(n)},
-              {"t_limit", num(t_limit)},
-              {"dt", num(dt)},
-              {"skin", num(std::max(0.25 * diameter, 0.002))},
-              {"traj_every", steps(d.real("transport.trajectory_interval"))},
-              {"vtk_every", steps(d.real("transport.vtk_interval"))},
-              {"density", num(density)},
-              {"E", num(ctx.cfg.ore.real("youngs_modulus"))},
-              {"nu", num(ctx.cfg.ore.real("poisson_ratio"))},
-              {"restitution", num(ctx.cfg.ore.real("restitution"))},
-              {"friction", num(ctx.cfg.ore.real("friction"))}};
-  const engine::Result res = engine::run_deck(ctx.runner, run, ctx.progress, label);
-  const auto end = read_end(work / "end.txt");
+  run.job = "transport/" + r.label;
+  run.vars = transport_vars(ctx, r, stl);
+  r.wall_seconds = engine::run_deck(ctx.runner, run, ctx.progress, r.label).seconds;
+  r.end = read_end(r.work / "end.txt");
+}
 
-  // Statistics.
+// The run's impacts (labelled by part), contact ends, trajectories and their
+// statistics.
+struct TransportResults {
   std::vector<double> insert_time;
-  for (const auto& l : lumps) insert_time.push_back(l.t);
-  auto records = post::ReadImpactsCsv((work / "impacts.csv").string());
-  const auto ends = post::ReadContactEndsCsv((work / "contact_ends.csv").string());
-  const auto traj = post::ReadTrajectoryDump((work / "traj.dump").string(), dt);
+  std::vector<post::ImpactRecord> records;
+  std::vector<post::ContactEnd> ends;
+  post::Trajectories traj;
+  post::TransportStats st;
+};
+
+TransportResults read_transport_results(const TransportRun& r, double sliding_threshold) {
+  TransportResults t;
+  for (const auto& l : r.lumps) t.insert_time.push_back(l.t);
+  t.records = post::ReadImpactsCsv((r.work / "impacts.csv").string());
+  t.ends = post::ReadContactEndsCsv((r.work / "contact_ends.csv").string());
+  t.traj = post::ReadTrajectoryDump((r.work / "traj.dump").string(), r.dt);
   post::MillShape shape;
-  shape.height = g.height;
-  shape.width = g.width;
-  shape.depth = g.depth;
-  shape.axis_x = g.axis_x;
-  shape.axis_y = g.axis_height;
-  shape.hub_radius = g.hub_radius();
-  shape.tip_radius = g.tip_radius();
-  const double sliding_threshold = d.real("transport.sliding_threshold");
-  post::LabelImpacts(records, shape, sliding_threshold);
-  const post::TransportStats st = post::ComputeTransportStats(records, insert_time, ends);
+  shape.height = r.g.height;
+  shape.width = r.g.width;
+  shape.depth = r.g.depth;
+  shape.axis_x = r.g.axis_x;
+  shape.axis_y = r.g.axis_height;
+  shape.hub_radius = r.g.hub_radius();
+  shape.tip_radius = r.g.tip_radius();
+  post::LabelImpacts(t.records, shape, sliding_threshold);
+  t.st = post::ComputeTransportStats(t.records, t.insert_time, t.ends);
+  return t;
+}
+
+// Cross-check (method.md): rim speed, and a ballistic impact speed: the lump
+// falls from the inlet to the rotor top (drag neglected) and meets a plate
+// moving at omega r_struck across its path.
+struct CrossCheck {
+  double v_in = 0, v_approach = 0, r_struck = 0, v_rotor = 0, v_ballistic = 0;  // m/s, m
+};
+
+CrossCheck cross_check(const TransportRun& r, const post::SurfaceStats& fly) {
+  const geometry::MillGeometry& g = r.g;
+  CrossCheck c;
+  for (const auto& l : r.lumps) c.v_in += -l.v[1] / static_cast<double>(r.lumps.size());
+  const double fall = std::max(0.0, g.height - 0.5 * r.diameter - (g.axis_height + g.tip_radius()));
+  c.v_approach = std::sqrt(std::max(0.0, c.v_in) * std::max(0.0, c.v_in) + 2 * kG * fall);
+  c.r_struck = fly.n > 0 ? fly.axis_distance.mean : g.tip_radius();
+  c.v_rotor = r.omega * c.r_struck;
+  c.v_ballistic = std::hypot(c.v_approach, c.v_rotor);
+  return c;
+}
+
+// summary.json's counts of gentle contacts (touch-downs, rolling and chatter
+// rather than impacts) and of outliers (a lump struck by the rotor reaches
+// at most about twice the rim speed), with a warning for the latter.
+void contact_counts(StageContext& ctx, nlohmann::json& j, const TransportRun& r,
+                    const TransportResults& t) {
+  long long gentle_fly = 0, gentle_wall = 0;
+  for (const auto& rec : t.records)
+    if (rec.normal_speed_m_s < 1.0) ++(rec.surface == "flywheel" ? gentle_fly : gentle_wall);
+  long long outliers = 0;
+  for (const auto& rec : t.records)
+    if (rec.particle_speed_m_s > 3 * r.omega * r.g.tip_radius()) ++outliers;
+  j["n_impacts_above_3x_rim_speed"] = outliers;
+  if (outliers > 0)
+    ctx.progress.warn(fmt::format(
+        "transport {}: {} impacts of lumps faster than 3x the rim speed (numerical: lumps "
+        "created overlapping, or a too large injection.timestep)",
+        r.label, outliers));
+  j["n_flywheel_contacts_below_1m_s"] = gentle_fly;
+  j["n_wall_contacts_below_1m_s"] = gentle_wall;
+}
+
+// summary.json of the run.
+nlohmann::json transport_summary(StageContext& ctx, const TransportRun& r,
+                                 const TransportResults& t, const CrossCheck& x,
+                                 const nlohmann::json& flow_converged) {
+  const auto& d = ctx.cfg.doc;
+  const post::TransportStats& st = t.st;
   const post::SurfaceStats& fly = st.surfaces.at("flywheel");
   const post::SurfaceStats& wall = st.surfaces.at("housing");
-
-  // Cross-check (method.md): rim speed, and a ballistic impact speed: the lump
-  // falls from the inlet to the rotor top (drag neglected) and meets a plate
-  // moving at omega r_struck across its path.
-  double v_in = 0;
-  for (const auto& l : lumps) v_in += -l.v[1] / static_cast<double>(lumps.size());
-  const double fall = std::max(0.0, g.height - 0.5 * diameter - (g.axis_height + g.tip_radius()));
-  const double v_approach = std::sqrt(std::max(0.0, v_in) * std::max(0.0, v_in) + 2 * kG * fall);
-  const double r_struck = fly.n > 0 ? fly.axis_distance.mean : g.tip_radius();
-  const double v_rotor = omega * r_struck;
-  const double v_ballistic = std::hypot(v_approach, v_rotor);
-
+  const auto& end = r.end;
   nlohmann::json j;
-  j["rpm"] = rpm;
+  j["rpm"] = r.rpm;
   j["n_particles"] = st.n_particles;
   j["n_exited"] = std::llround(end[2]);
   j["n_remaining"] = std::llround(end[1]);
@@ -400,49 +468,41 @@ void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pa
   put(j, "wall_impact_speed", wall.speed, "m_s");
   put(j, "wall_normal_speed", wall.normal_speed, "m_s");
   put(j, "wall_angle", wall.angle, "deg");
-  strike_keys(j, st, sliding_threshold);
+  strike_keys(j, st, d.real("transport.sliding_threshold"));
   j["flow_converged"] = flow_converged;
   j["flow_allow_unconverged"] = d.boolean("flow.allow_unconverged");
-  long long gentle_fly = 0,
-            gentle_wall = 0;  // touch-downs, rolling and chatter rather than impacts
-  for (const auto& r : records)
-    if (r.normal_speed_m_s < 1.0) ++(r.surface == "flywheel" ? gentle_fly : gentle_wall);
-  long long outliers = 0;  // a lump struck by the rotor reaches at most about twice the rim speed
-  for (const auto& r : records)
-    if (r.particle_speed_m_s > 3 * omega * g.tip_radius()) ++outliers;
-  j["n_impacts_above_3x_rim_speed"] = outliers;
-  if (outliers > 0)
-    ctx.progress.warn(fmt::format(
-        "transport {}: {} impacts of lumps faster than 3x the rim speed (numerical: lumps "
-        "created overlapping, or a too large injection.timestep)",
-        label, outliers));
-  j["n_flywheel_contacts_below_1m_s"] = gentle_fly;
-  j["n_wall_contacts_below_1m_s"] = gentle_wall;
+  contact_counts(ctx, j, r, t);
   j["impacts_per_particle_mean"] = st.impacts_per_particle_mean;
   j["flywheel_impacts_per_particle_mean"] = st.flywheel_impacts_per_particle_mean;
   j["first_impact_time_mean_s"] = st.first_impact_time_mean_s;
   j["first_impact_time_note"] =
-      "time from insertion to the first impact (any surface; sliding contacts are not impacts), over particles with one";
+      "time from insertion to the first impact (any surface; sliding contacts are not impacts), "
+      "over particles with one";
   j["particles_with_impact"] = st.particles_with_impact;
-  j["cross_check"] = {{"rim_speed_m_s", omega * g.tip_radius()},
-                      {"inlet_velocity_down_mean_m_s", v_in},
-                      {"ballistic_approach_speed_m_s", v_approach},
-                      {"struck_radius_m", r_struck},
-                      {"rotor_speed_at_struck_radius_m_s", v_rotor},
-                      {"ballistic_impact_speed_m_s", v_ballistic},
+  j["cross_check"] = {{"rim_speed_m_s", r.omega * r.g.tip_radius()},
+                      {"inlet_velocity_down_mean_m_s", x.v_in},
+                      {"ballistic_approach_speed_m_s", x.v_approach},
+                      {"struck_radius_m", x.r_struck},
+                      {"rotor_speed_at_struck_radius_m_s", x.v_rotor},
+                      {"ballistic_impact_speed_m_s", x.v_ballistic},
                       {"simulated_approach_speed_mean_m_s", fly.particle_speed.mean}};
-  j["timestep_s"] = dt;
-  j["wall_seconds"] = res.seconds;
+  j["timestep_s"] = r.dt;
+  j["wall_seconds"] = r.wall_seconds;
   j["units"] = "SI; angles in degrees to the surface plane (90 = normal)";
+  return j;
+}
 
+// transport.h5's scalars (with units) and mill geometry.
+post::TransportMeta transport_meta(const TransportRun& r) {
+  const geometry::MillGeometry& g = r.g;
   post::TransportMeta meta;
-  meta.scalars = {{"rpm", rpm},
-                  {"omega", omega},
-                  {"rim_speed", omega * g.tip_radius()},
-                  {"timestep", dt},
-                  {"lump_diameter", diameter},
-                  {"lump_density", density},
-                  {"end_time", end[0]}};
+  meta.scalars = {{"rpm", r.rpm},
+                  {"omega", r.omega},
+                  {"rim_speed", r.omega * g.tip_radius()},
+                  {"timestep", r.dt},
+                  {"lump_diameter", r.diameter},
+                  {"lump_density", r.density},
+                  {"end_time", r.end[0]}};
   meta.units = {{"rpm", "1/min"},  {"omega", "rad/s"},     {"rim_speed", "m/s"},
                 {"timestep", "s"}, {"lump_diameter", "m"}, {"lump_density", "kg/m^3"},
                 {"end_time", "s"}};
@@ -459,42 +519,47 @@ void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pa
                    {"outlet_size", g.outlet_size},
                    {"n_plates", static_cast<double>(g.n_plates)},
                    {"plate_thickness", g.plate_thickness}};
+  return meta;
+}
 
-  // Outputs: transport/<label>/, each file complete or absent.
-  const fs::path out = ctx.stage_dir / label;
+// Outputs: transport/<label>/{transport.h5, impacts.csv, contact_ends.csv,
+// plots/, summary.json}, each file complete or absent.
+void write_transport_outputs(StageContext& ctx, const TransportRun& r, const TransportResults& t,
+                             const nlohmann::json& summary, const fs::path& out) {
   fs::create_directories(out);
   for (const char* f : {"summary.json", "impacts.csv", "contact_ends.csv", "transport.h5"})
     fs::remove(out / f);
-  post::WriteTransportH5((out / "transport.h5").string(), records, st, insert_time, traj, meta,
-                         ends);
-  post::WriteImpactsCsv((out / "impacts.csv").string(), records);
+  post::WriteTransportH5((out / "transport.h5").string(), t.records, t.st, t.insert_time, t.traj,
+                         transport_meta(r), t.ends);
+  post::WriteImpactsCsv((out / "impacts.csv").string(), t.records);
   {
-    std::ifstream in(work / "contact_ends.csv");
+    std::ifstream in(r.work / "contact_ends.csv");
     std::stringstream ss;
     ss << in.rdbuf();
     jobs::atomic_write(out / "contact_ends.csv", ss.str());
   }
-  engine::Command c;
-  c.argv = {"/usr/bin/python3",
-            (ctx.cfg.project_dir / "postprocess" / "plot_transport.py").string(),
-            "--h5",
-            (out / "transport.h5").string(),
-            "--out",
-            (out / "plots").string()};
-  c.cwd = out;
-  c.log = out / "plots.log";
-  c.job = "transport/" + label + "/plots";
-  ctx.runner.run(c);
-  jobs::atomic_write(out / "summary.json", j.dump(2) + "\n");
+  engine::run_python(ctx.runner, ctx.cfg.project_dir / "postprocess" / "plot_transport.py",
+                     {"--h5", (out / "transport.h5").string(), "--out", (out / "plots").string()},
+                     out / "plots.log", "transport/" + r.label + "/plots");
+  jobs::atomic_write(out / "summary.json", summary.dump(2) + "\n");
+}
 
+// The run in four lines: impacts, strikes, the cross-check, the outputs.
+void log_transport(StageContext& ctx, const TransportRun& r, const TransportResults& t,
+                   const CrossCheck& x, const fs::path& out) {
+  const post::TransportStats& st = t.st;
+  const post::SurfaceStats& fly = st.surfaces.at("flywheel");
+  const post::SurfaceStats& wall = st.surfaces.at("housing");
+  const std::string& label = r.label;
   ctx.progress.info(fmt::format(
       "[transport] {}: {} lumps, {} exited, {} flywheel impacts ({:.2f} per lump): speed {:.1f} +- "
       "{:.1f} m/s, "
       "normal {:.1f} m/s, angle {:.1f} deg; {} wall impacts; {} sliding contacts (below {:g} m/s "
       "normal); first impact after {:.3f} s [{:.1f} s]",
-      label, st.n_particles, std::llround(end[2]), fly.n, st.flywheel_impacts_per_particle_mean,
+      label, st.n_particles, std::llround(r.end[2]), fly.n, st.flywheel_impacts_per_particle_mean,
       fly.speed.mean, fly.speed.std, fly.normal_speed.mean, fly.angle.mean, wall.n,
-      st.sliding_contacts, sliding_threshold, st.first_impact_time_mean_s, res.seconds));
+      st.sliding_contacts, ctx.cfg.doc.real("transport.sliding_threshold"),
+      st.first_impact_time_mean_s, r.wall_seconds));
   ctx.progress.info(fmt::format(
       "[transport] {}: {} first and {} later beater strikes (first {:.1f} m/s); lumps leave the "
       "beaters at {:.1f} +- {:.1f} m/s (lab); {} strikes reach the housing next, at {:.1f} +- "
@@ -507,11 +572,40 @@ void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pa
       "[transport] {}: cross-check: rim speed {:.1f} m/s; ballistic estimate {:.1f} m/s (approach "
       "{:.1f} m/s, "
       "rotor {:.1f} m/s at r = {:.3f} m) vs simulated mean {:.1f} m/s",
-      label, omega * g.tip_radius(), v_ballistic, v_approach, v_rotor, r_struck, fly.speed.mean));
+      label, r.omega * r.g.tip_radius(), x.v_ballistic, x.v_approach, x.v_rotor, x.r_struck,
+      fly.speed.mean));
   ctx.progress.info(fmt::format(
       "[transport] results: {}/{{impacts.csv, contact_ends.csv, transport.h5, summary.json, "
       "plots/*.png}}",
       out.string()));
+}
+
+}  // namespace
+
+// Runs the lumps through the mill at one rotor speed and writes the results
+// into transport/<label>/ (each file complete or absent).
+void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& job_dir) {
+  const auto& d = ctx.cfg.doc;
+  TransportRun r;
+  r.label = job.label;
+  r.rpm = job.inputs.at("rotor.rpm").get<double>();
+  r.field_file = sampled_field(ctx, r.label, r.rpm);
+  const nlohmann::json flow_converged = check_flow_converged(ctx, r.label);
+  // injection.time_limit > duration and the time step: checked with the case.
+  r.g = geometry::MillGeometry::from_config(d);
+  r.omega = r.rpm * 2 * kPi / 60.0;
+  r.diameter = d.real("injection.lump_diameter");
+  r.dt = d.real("injection.timestep");
+  r.density = ctx.cfg.ore.real("density");
+  r.work = job_dir / "run";
+
+  run_transport_deck(ctx, r);
+  const TransportResults t = read_transport_results(r, d.real("transport.sliding_threshold"));
+  const CrossCheck x = cross_check(r, t.st.surfaces.at("flywheel"));
+  const nlohmann::json summary = transport_summary(ctx, r, t, x, flow_converged);
+  const fs::path out = ctx.stage_dir / r.label;
+  write_transport_outputs(ctx, r, t, summary, out);
+  log_transport(ctx, r, t, x, out);
 }
 
 }  // namespace mill

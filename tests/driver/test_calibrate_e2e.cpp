@@ -18,7 +18,7 @@
 
 #include "config/case_config.h"
 #include "e2e_util.h"
-#include "stages/material.h"
+#include "lump/material.h"
 
 namespace fs = std::filesystem;
 

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "lump/material.h"
 #include "stages/calibrate/lab_runs.h"
-#include "stages/material.h"
 
 namespace mill::calibrate {
 

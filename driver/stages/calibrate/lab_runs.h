@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "engine/runner.h"
+#include "lump/material.h"
 #include "postprocess/energy_ledger.h"
 #include "postprocess/lab_tests.h"
 #include "stages/calibrate/specimen.h"
-#include "stages/material.h"
 #include "stages/stage.h"
 
 namespace mill::calibrate {

@@ -385,19 +385,10 @@ void write_outputs(StageContext& ctx, const fs::path& dir, const Fitting& fit, c
   jobs::atomic_write(dir / "curves.csv", r.curves());
   jobs::atomic_write(dir / "report.json", r.json().dump(2) + "\n");
   jobs::atomic_write(dir / "report.md", r.markdown());
-  engine::Command c;
-  c.argv = {"/usr/bin/python3",
-            (ctx.cfg.project_dir / "postprocess" / "plot_lab_tests.py").string(),
-            "--curves",
-            (dir / "curves.csv").string(),
-            "--report",
-            (dir / "report.json").string(),
-            "--out",
-            (dir / "plots").string()};
-  c.cwd = dir;
-  c.log = dir / "plots.log";
-  c.job = "calibrate/plots";
-  ctx.runner.run(c);
+  engine::run_python(ctx.runner, ctx.cfg.project_dir / "postprocess" / "plot_lab_tests.py",
+                     {"--curves", (dir / "curves.csv").string(), "--report",
+                      (dir / "report.json").string(), "--out", (dir / "plots").string()},
+                     dir / "plots.log", "calibrate/plots");
   // Last: the file the breakage stage reads.
   jobs::atomic_write(
       dir / "calibrated.yaml",

@@ -10,13 +10,11 @@
 #include <sstream>
 #include <vector>
 
-#include "engine/liggghts.h"
+#include "lump/packing.h"
 #include "progress.h"
-#include "stages/lump_builder.h"
 
 namespace mill::calibrate {
 namespace fs = std::filesystem;
-using engine::num;
 
 namespace {
 
@@ -96,70 +94,43 @@ double info_at(const std::map<std::string, double>& m, const std::string& key,
   return it->second;
 }
 
-// Pack a ball of polydisperse elements with the lump builder's deck and
-// procedure (same radius classes, spread and element size as the lump).
+namespace {
+
+// The ball the specimens are carved from: kBallFactor x n elements of the
+// lump's size (same radius classes, spread and mean radius as the lump),
+// seed stream prime_stream(calibrate.seed) (packing_seeds).
+BallPacking specimen_ball(const config::CaseConfig& cfg, long n) {
+  const config::Document& d = cfg.doc;
+  BallPacking b;
+  b.spread = d.real("lump.radius_spread");
+  b.mean_radius =
+      target_mean_radius(d.integer("lump.n_elements"), d.real("lump.diameter"), b.spread);
+  b.n_elements = static_cast<long>(std::ceil(kBallFactor * static_cast<double>(n)));
+  b.density = cfg.ore.real("density");
+  b.nu = cfg.ore.real("poisson_ratio");
+  b.bond_gap = d.real("lump.bond_gap");
+  b.max_bonds = d.integer("lump.max_bonds");
+  b.seed_stream = prime_stream(d.integer("calibrate.seed"));
+  return b;
+}
+
+}  // namespace
+
+// Pack a ball of polydisperse elements with the lump's packing (pack_ball)
+// and carve the n-element specimens from it.
 Specimen pack_specimen(StageContext& ctx, const std::string& job_label, const fs::path& dir,
                        long n) {
-  const config::Document& d = ctx.cfg.doc;
-  const config::Document& ore = ctx.cfg.ore;
   Specimen s;
-  const double spread = d.real("lump.radius_spread");
-  const double rm =
-      target_mean_radius(d.integer("lump.n_elements"), d.real("lump.diameter"), spread);
-  const long nb = static_cast<long>(std::ceil(kBallFactor * static_cast<double>(n)));
-  const double rho = ore.real("density"), nu = ore.real("poisson_ratio");
-  const double rmin = rm * class_factor(0, spread);
-  const double solid =
-      static_cast<double>(nb) * 4.0 / 3.0 * M_PI * rm * rm * rm * mean_cube_factor(spread);
-  const double r_insert = std::cbrt(solid / 0.25 * 3.0 / (4.0 * M_PI));  // loose: 25% solid
-  // As in lump_builder.cpp: soft packing modulus, 20% of the Rayleigh step,
-  // central pull until jammed, viscous relaxation.
-  const double E_build = 1e8, G = E_build / (2 * (1 + nu));
-  const double dt = 0.2 * M_PI * rmin * std::sqrt(rho / G) / (0.1631 * nu + 0.8766);
-  const double pull = 200.0;
-  const double t_pull = 2.5 * std::sqrt(2.0 * r_insert / pull);
-  const double m_mean = rho * 4.0 / 3.0 * M_PI * rm * rm * rm;
-  const long seed = d.integer("calibrate.seed");
-  // Two distinct primes (prime_seed of neighbouring bases can coincide).
-  const long seed_dist = prime_seed(seed), seed_ins = prime_seed((seed_dist - 20000) / 7 + 1);
+  const BallPacking ball = specimen_ball(ctx.cfg, n);
+  const long nb = ball.n_elements;
   const fs::path work = dir / "specimen";
-  fs::remove_all(work);
-  engine::DeckRun run;
-  run.deck = ctx.cfg.project_dir / "liggghts_inputs" / "lump_build.in.tmpl";
-  run.workdir = work;
-  run.np = 1;
-  run.job = "calibrate/" + job_label + "/specimen";
-  run.vars = {{"n_elements", std::to_string(nb)},
-              {"r_insert", num(r_insert)},
-              {"density", num(rho)},
-              {"nu", num(nu)},
-              {"E_build", num(E_build)},
-              {"dt", num(dt)},
-              {"pull_accel", num(pull)},
-              {"gamma", num(m_mean / 0.03)},
-              {"n_compact", std::to_string(static_cast<long>(std::ceil(t_pull / dt)))},
-              {"n_relax", std::to_string(static_cast<long>(std::ceil(0.3 * t_pull / dt)))},
-              {"skin", num(0.3 * rm)},
-              {"seed_dist", std::to_string(seed_dist)},
-              {"seed_ins", std::to_string(seed_ins)},
-              {"bond_gap", num(d.real("lump.bond_gap"))},
-              {"max_bonds", std::to_string(d.integer("lump.max_bonds"))},
-              {"r_mean", num(rm)},
-              {"out", "ball.data"},
-              {"info", "ball_info.txt"}};
-  for (int k = 0; k < 5; ++k)
-    run.vars.push_back({fmt::format("r{}", k), num(rm * class_factor(k, spread))});
   ctx.progress.job_step(job_label, fmt::format("packing a ball of {} elements", nb), 0.0);
   ctx.progress.info(fmt::format(
       "[calibrate] packing a ball of {} elements (mean radius {:.3f} mm, as the lump) to carve "
       "the specimens from",
-      nb, rm * 1e3));
-  engine::run_deck(ctx.runner, run, ctx.progress, job_label);
-  const LumpInfo li = parse_lump_info(work / "ball_info.txt");
-  if (li.elements != nb)
-    throw std::runtime_error(
-        fmt::format("specimen: only {} of {} elements could be packed (see {})", li.elements, nb,
-                    (work / "liggghts.log").string()));
+      nb, ball.mean_radius * 1e3));
+  const LumpInfo li = pack_ball({ctx.runner, ctx.progress, ctx.cfg.project_dir}, ball, work, "ball",
+                                "calibrate/" + job_label + "/specimen", job_label);
   s.ball = work / "ball.data";
   s.ball_elements = li.elements;
   s.ball_outer_radius = li.outer_radius;

@@ -5,14 +5,13 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
-
 #include <optional>
 #include <vector>
 
 #include "postprocess/breakage_results.h"
 #include "stages/stage.h"
 
-namespace mill {
+namespace mill::breakage {
 
 // Sieve sizes in mm of a list of relative fraction edges: the edges above 0
 // times the lump size in mm (sizes are d/D x lump.diameter, docs/breakage.md).
@@ -20,7 +19,8 @@ std::vector<double> sieves_mm(const std::vector<double>& edges_rel, double lump_
 
 // A passing curve as JSON: sieves_mm, passing_percent, p50_mm and p80_mm
 // (null when finer than the finest sieve), from the mass per size fraction.
-nlohmann::json passing_json(const std::vector<double>& sieves, const std::vector<double>& fraction_mass);
+nlohmann::json passing_json(const std::vector<double>& sieves,
+                            const std::vector<double>& fraction_mass);
 
 // breakage/jk_fit.json, jk_points.csv, /jk_fit in breakage.h5 and
 // plots/jk_t10_vs_ecs.png: t10 = A (1 - exp(-b Ecs)) fitted per impact angle
@@ -32,4 +32,4 @@ void write_jk_fit(StageContext& ctx, const std::vector<post::ImpactSummary>& row
 // (and P80's range over the repeats).
 void write_size_distributions(StageContext& ctx, const std::vector<post::FractionRow>& fractions);
 
-}  // namespace mill
+}  // namespace mill::breakage

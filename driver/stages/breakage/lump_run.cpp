@@ -1,5 +1,5 @@
 // Shared parts of the bonded-lump runs (impact and in-mill).
-#include "stages/lump_run.h"
+#include "stages/breakage/lump_run.h"
 
 #include <fmt/format.h>
 #include <vtkCellArray.h>
@@ -22,7 +22,7 @@
 #include "progress.h"
 #include "stages/stage_util.h"
 
-namespace mill {
+namespace mill::breakage {
 namespace fs = std::filesystem;
 using engine::num;
 
@@ -112,7 +112,8 @@ LumpRun prepare_lump_run(StageContext& ctx, int repeat, const fs::path& out_dir,
   const auto& d = ctx.cfg.doc;
   LumpRun run;
   const int packing = static_cast<int>(repeat % d.integer("lump.n_packings"));
-  run.lump = ensure_lump(ctx, lump_spec(ctx.cfg), packing, label);
+  run.lump = ensure_lump({ctx.runner, ctx.progress, ctx.cfg.project_dir},
+                         ctx.run_dir / "breakage" / "lumps", lump_spec(ctx.cfg), packing, label);
   run.bond = bond_params_for(ctx.cfg, ctx.run_dir);
   run.rotation = random_rotation(
       1469598103ULL * static_cast<unsigned long long>(d.integer("lump.seed")) + 7919ULL * repeat);
@@ -256,4 +257,4 @@ std::string damaged_lump_outputs(const fs::path& dir) {
   return "";
 }
 
-}  // namespace mill
+}  // namespace mill::breakage

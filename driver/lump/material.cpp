@@ -1,5 +1,5 @@
 // Ore material and bond parameters for the decks.
-#include "stages/material.h"
+#include "lump/material.h"
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
@@ -8,12 +8,11 @@
 
 #include "engine/liggghts.h"
 #include "jobs/job_store.h"
-#include "stages/stage_util.h"
 
 namespace mill {
 namespace fs = std::filesystem;
 
-std::string ore_hash(const config::Document& ore) { return jobs::job_id(ore_keys(ore)); }
+std::string ore_hash(const config::Document& ore) { return jobs::job_id(config::ore_keys(ore)); }
 
 BondParams estimate_bond_params(const config::Document& ore, double radius_multiplier) {
   // Starting point only; `--stage calibrate` replaces it. Potyondy & Cundall

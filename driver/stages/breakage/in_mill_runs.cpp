@@ -1,5 +1,5 @@
 // In-mill breakage jobs: start states, the run, the record, the product.
-#include "stages/in_mill_runs.h"
+#include "stages/breakage/in_mill_runs.h"
 
 #include <fmt/format.h>
 
@@ -14,11 +14,11 @@
 #include "postprocess/in_mill.h"
 #include "postprocess/lammps_dump.h"
 #include "progress.h"
-#include "stages/breakage_summaries.h"
-#include "stages/lump_run.h"
+#include "stages/breakage/lump_run.h"
+#include "stages/breakage/summaries.h"
 #include "stages/stage_util.h"
 
-namespace mill {
+namespace mill::breakage {
 namespace fs = std::filesystem;
 using engine::num;
 
@@ -110,7 +110,7 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan) {
   if (gas)
     for (const char* p : {"gas.", "flow.", "sample."}) keys.push_back(p);
   nlohmann::json base = case_keys(d, keys);
-  base["ore"] = ore_keys(ctx.cfg.ore);
+  base["ore"] = config::ore_keys(ctx.cfg.ore);
   base["bond"] = bond_json(bond_params_for(ctx.cfg, ctx.run_dir), BondNames::job);
   base["in_mill_deck_version"] = kInMillDeckVersion;
   base["mode"] = "in_mill";
@@ -138,23 +138,25 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan) {
   }
 }
 
-std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& out_dir) {
+namespace {
+
+// The sampled gas field of the rotor speed when breakage.in_mill.gas is set
+// (else none), or MissingInput naming the command that makes it.
+fs::path gas_field(const StageContext& ctx, const std::string& label, double rpm) {
   const auto& d = ctx.cfg.doc;
-  const auto& in = job.inputs;
-  const std::string label = job.label;
-  const double rpm = in.at("rpm").get<double>(), omega = omega_of(rpm);
-  const int repeat = in.at("repeat").get<int>();
-  const bool gas = d.boolean("breakage.in_mill.gas");
+  if (!d.boolean("breakage.in_mill.gas")) return {};
   const fs::path field_file = ctx.run_dir / "sample" / rpm_label(rpm) / "field.h5";
-  if (gas && !fs::exists(field_file))
+  if (!fs::exists(field_file))
     throw MissingInput(fmt::format(
         "in-mill breakage ({}) needs {} (the sampled gas field at {:g} rpm, breakage.in_mill.gas: "
         "true); make it with "
         "`orchestrate --case {} --stage sample --output {}`, or set breakage.in_mill.gas: false",
         label, field_file.string(), rpm, d.file(), ctx.run_dir.string()));
+  return field_file;
+}
 
-  const LumpRun lr = prepare_lump_run(ctx, repeat, out_dir, label);
-  // The mill, its flywheel turned to its angle at the start.
+// The mill of a run, its flywheel turned to the job's angle at the start.
+geometry::MillGeometry run_geometry(const config::Document& d, const nlohmann::json& in) {
   geometry::MillGeometry g = geometry::MillGeometry::from_config(d);
   g.rotor_angle = in.at("rotor_angle_rad").get<double>();
   // The hub circle drawn with kHubFacets instead of 96 facets: the impact
@@ -162,71 +164,89 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
   // facets took half the run time); the polygon departs from the circle by
   // r (1 - cos(pi / kHubFacets)), 1.3 mm on a 0.3 m hub.
   g.arc_segments = kHubFacets;
-  fs::create_directories(lr.work);
-  const geometry::StlSet stl = geometry::write_stl_set(g, lr.work / "stl");
+  return g;
+}
 
-  // Neighbour bins: the box holds the whole mill, so the bins start large
-  // enough that it holds at most neighbour_bins of them.
-  const double margin = 0.05;
-  const double box_volume =
-      (g.width + 2 * margin) * (g.height + 2 * margin) * (g.depth + 2 * margin);
-  const double bin0 = std::max(
-      4.0 * lr.lump.mean_radius,
-      std::cbrt(box_volume / static_cast<double>(d.integer("breakage.in_mill.neighbour_bins"))));
-  // The fastest an element is expected to move: its start speed plus twice
-  // the rim speed (flung by a beater, elastic at most).
-  const auto x0 = vec3(in.at("position")), v0 = vec3(in.at("velocity"));
-  const double v_max = std::hypot(v0[0], v0[1], v0[2]) + 2 * omega * g.tip_radius();
-  const double dt_speed = kStepMove * lr.r_min / v_max;
+// The step bound of a run: the fastest an element is expected to move (its
+// start speed plus twice the rim speed: flung by a beater, elastic at most)
+// and the step that keeps it under kStepMove of the smallest element radius.
+struct StepBound {
+  double v_max = 0;
+  double dt_speed = 0;
+};
+
+// The step bound; throws naming breakage.timestep when the case's step is larger.
+StepBound step_bound(const config::Document& d, const geometry::MillGeometry& g, const LumpRun& lr,
+                     const std::array<double, 3>& v0, double omega) {
+  StepBound b;
+  b.v_max = std::hypot(v0[0], v0[1], v0[2]) + 2 * omega * g.tip_radius();
+  b.dt_speed = kStepMove * lr.r_min / b.v_max;
   const double dt_given = d.real("breakage.timestep");
-  if (dt_given > dt_speed)
+  if (dt_given > b.dt_speed)
     throw std::runtime_error(
         fmt::format("{}: at up to {:.0f} m/s (start speed plus twice the rim speed) an element "
                     "moves {:.3g} m per step of {:g} s, "
                     "more than {:g} of the smallest element radius ({:.3g} m); expected "
                     "breakage.timestep <= {:.3g} s, or 0 "
                     "(automatic)",
-                    d.where("breakage.timestep"), v_max, v_max * dt_given, dt_given, kStepMove,
-                    lr.r_min, dt_speed));
+                    d.where("breakage.timestep"), b.v_max, b.v_max * dt_given, dt_given, kStepMove,
+                    lr.r_min, b.dt_speed));
+  return b;
+}
 
-  engine::DeckRun run;
-  run.deck = ctx.cfg.project_dir / "liggghts_inputs" / "in_mill.in.tmpl";
-  run.workdir = lr.work;
-  run.np = ctx.opts.np;
-  run.job = "breakage/" + label;
-  run.vars = {{"housing_stl", fs::absolute(stl.housing).string()},
-              {"flywheel_stl", fs::absolute(stl.flywheel).string()},
-              {"axis_x", num(g.axis_x)},
-              {"axis_y", num(g.axis_height)},
-              {"omega", num(omega)},
-              {"rim_speed", num(std::fabs(omega) * g.tip_radius())},
-              {"g", num(kG)},
-              {"x0", num(x0[0])},
-              {"y0", num(x0[1])},
-              {"z0", num(x0[2])},
-              {"vx0", num(v0[0])},
-              {"vy0", num(v0[1])},
-              {"vz0", num(v0[2])},
-              {"gas", gas ? "1" : "0"},
-              {"field_file", gas ? fs::absolute(field_file).string() : std::string("none")},
-              {"viscosity", num(d.real("gas.viscosity"))},
-              {"t_end", num(d.real("breakage.in_mill.duration"))},
-              {"dt", num(dt_given)},
-              {"dt_speed", num(dt_speed)},
-              {"skin", num(kSkinRadii * lr.lump.mean_radius)},
-              {"binsize", num(bin0)},
-              {"dump_interval", num(d.real("breakage.dump_interval"))}};
-  for (const auto& kv : lump_deck_vars(ctx, lr)) run.vars.push_back(kv);
-  const engine::Result res = engine::run_deck(ctx.runner, run, ctx.progress, label);
+// The first neighbour bin size: the box holds the whole mill, so the bins
+// start large enough that it holds at most breakage.in_mill.neighbour_bins.
+double first_bin(const config::Document& d, const geometry::MillGeometry& g, const LumpRun& lr) {
+  const double margin = 0.05;
+  const double box_volume =
+      (g.width + 2 * margin) * (g.height + 2 * margin) * (g.depth + 2 * margin);
+  return std::max(
+      4.0 * lr.lump.mean_radius,
+      std::cbrt(box_volume / static_cast<double>(d.integer("breakage.in_mill.neighbour_bins"))));
+}
 
-  // Fragments, judged at the strike's relative speed (its specific energy).
-  const double v_strike = in.at("strike_speed_m_s").get<double>(),
-               a_strike = in.at("strike_angle_deg").get<double>();
-  const LumpRunResult a = analyse_lump_run(
-      ctx, lr, {v_strike, std::clamp(a_strike, 0.0, 90.0), repeat}, res.seconds, label);
-  // Walls are impenetrable: an element beside the housing, between floor and
-  // roof, passed through a side wall between steps (elements that left
-  // through the openings in the floor or the roof fly on outside).
+// The -var pairs of in_mill.in.tmpl: the mill (its STL files), the lump's
+// start, the gas, the time and neighbour settings, and the lump's own.
+std::vector<std::pair<std::string, std::string>> in_mill_vars(
+    const StageContext& ctx, const nlohmann::json& in, const geometry::MillGeometry& g,
+    const geometry::StlSet& stl, const LumpRun& lr, const fs::path& field_file,
+    const StepBound& step) {
+  const auto& d = ctx.cfg.doc;
+  const double omega = omega_of(in.at("rpm").get<double>());
+  const auto x0 = vec3(in.at("position")), v0 = vec3(in.at("velocity"));
+  const bool gas = !field_file.empty();
+  std::vector<std::pair<std::string, std::string>> v = {
+      {"housing_stl", fs::absolute(stl.housing).string()},
+      {"flywheel_stl", fs::absolute(stl.flywheel).string()},
+      {"axis_x", num(g.axis_x)},
+      {"axis_y", num(g.axis_height)},
+      {"omega", num(omega)},
+      {"rim_speed", num(std::fabs(omega) * g.tip_radius())},
+      {"g", num(kG)},
+      {"x0", num(x0[0])},
+      {"y0", num(x0[1])},
+      {"z0", num(x0[2])},
+      {"vx0", num(v0[0])},
+      {"vy0", num(v0[1])},
+      {"vz0", num(v0[2])},
+      {"gas", gas ? "1" : "0"},
+      {"field_file", gas ? fs::absolute(field_file).string() : std::string("none")},
+      {"viscosity", num(d.real("gas.viscosity"))},
+      {"t_end", num(d.real("breakage.in_mill.duration"))},
+      {"dt", num(d.real("breakage.timestep"))},
+      {"dt_speed", num(step.dt_speed)},
+      {"skin", num(kSkinRadii * lr.lump.mean_radius)},
+      {"binsize", num(first_bin(d, g, lr))},
+      {"dump_interval", num(d.real("breakage.dump_interval"))}};
+  for (const auto& kv : lump_deck_vars(ctx, lr)) v.push_back(kv);
+  return v;
+}
+
+// Walls are impenetrable: an element beside the housing, between floor and
+// roof, passed through a side wall between steps (elements that left
+// through the openings in the floor or the roof fly on outside). Throws then.
+void check_inside_walls(const LumpRunResult& a, const geometry::MillGeometry& g, const LumpRun& lr,
+                        const std::string& label) {
   const long through =
       std::count_if(a.snap.elements.begin(), a.snap.elements.end(), [&](const post::Element& e) {
         return e.x[1] >= 0 && e.x[1] <= g.height &&
@@ -237,13 +257,23 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
         fmt::format("{}: {} of {} elements ended outside the housing's side walls: they passed "
                     "through a wall between steps, the run is invalid; log: {}",
                     label, through, a.snap.elements.size(), (lr.work / "liggghts.log").string()));
+}
 
-  // The record: contacts, bonds broken at the strike and later, mass places.
+// The record of a run: its contacts, the bonds broken at the strike and
+// later, where the mass ended.
+struct MillRecord {
+  post::BreakSplit split;
+  post::ContactTally fly, wall;
+  post::MassPlaces mass;
+  double element_mass = 0;  // kg, all elements
+};
+
+MillRecord read_record(const LumpRun& lr, const LumpRunResult& a, const geometry::MillGeometry& g) {
+  MillRecord r;
   const auto contacts = post::ReadImpactsCsv((lr.work / "impacts.csv").string());
-  const auto split =
-      post::SplitBreaks(post::ReadBreakLog((lr.work / "breaks.txt").string()), contacts);
-  const auto fly = post::TallyContacts(contacts, "flywheel"),
-             wall = post::TallyContacts(contacts, "housing");
+  r.split = post::SplitBreaks(post::ReadBreakLog((lr.work / "breaks.txt").string()), contacts);
+  r.fly = post::TallyContacts(contacts, "flywheel");
+  r.wall = post::TallyContacts(contacts, "housing");
   post::MillRegions regions;
   regions.axis_x = g.axis_x;
   regions.axis_y = g.axis_height;
@@ -251,11 +281,15 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
   regions.half_width_z = 0.5 * g.plate_width;
   regions.floor_y = 0;
   regions.roof_y = g.height;
-  const auto mass = post::LocateMass(a.snap.elements, regions);
-  double element_mass = 0;
-  for (const auto& e : a.snap.elements) element_mass += e.mass;
+  r.mass = post::LocateMass(a.snap.elements, regions);
+  for (const auto& e : a.snap.elements) r.element_mass += e.mass;
+  return r;
+}
 
-  nlohmann::json j = lump_result_json(lr, a, res.seconds);
+// in_mill.json: result.json's keys (lump_result_json in `j`) and the run's
+// own: its start, the strike, the record.
+void add_in_mill_keys(nlohmann::json& j, const config::Document& d, const nlohmann::json& in,
+                      const MillRecord& r) {
   const auto tally = [](const post::ContactTally& t) {
     return nlohmann::json{{"contacts", t.n},
                           {"elements", t.n_elements},
@@ -264,7 +298,7 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
   };
   const auto when = [](double t) { return t >= 0 ? nlohmann::json(t) : nlohmann::json(nullptr); };
   j["mode"] = "in_mill";
-  j["rpm"] = rpm;
+  j["rpm"] = in.at("rpm").get<double>();
   j["start"] = {
       {"particle_id", in.at("particle_id")},
       {"time_in_transport_s", in.at("start_time_s")},
@@ -276,29 +310,31 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
       {"note",
        "the transport lump's state at its first flywheel strike, backed off ballistically (gravity "
        "only) by lead_time"}};
-  j["strike"] = {{"speed_m_s", v_strike},
+  j["strike"] = {{"speed_m_s", in.at("strike_speed_m_s").get<double>()},
                  {"normal_speed_m_s", in.at("strike_normal_speed_m_s")},
-                 {"angle_deg", a_strike}};
+                 {"angle_deg", in.at("strike_angle_deg").get<double>()}};
   j["duration_s"] = d.real("breakage.in_mill.duration");
-  j["gas"] = gas;
-  j["element_mass_kg"] = element_mass;
-  j["bonds_broken_at_strike"] = split.at_strike;
-  j["bonds_broken_later"] = split.later;
-  j["first_flywheel_contact_s"] = when(split.first_flywheel_contact_s);
-  j["first_housing_contact_s"] = when(split.first_housing_contact_s);
+  j["gas"] = d.boolean("breakage.in_mill.gas");
+  j["element_mass_kg"] = r.element_mass;
+  j["bonds_broken_at_strike"] = r.split.at_strike;
+  j["bonds_broken_later"] = r.split.later;
+  j["first_flywheel_contact_s"] = when(r.split.first_flywheel_contact_s);
+  j["first_housing_contact_s"] = when(r.split.first_housing_contact_s);
   j["strike_definition"] =
       "at the strike: broken from the lump's first element contact with the flywheel until the "
       "first element "
       "contact with the housing; later: after it (housing impacts and later strikes)";
-  j["flywheel"] = tally(fly);
-  j["housing"] = tally(wall);
-  j["mass_places"] = {{"rotor", mass.rotor},
-                      {"housing", mass.housing},
-                      {"outlet", mass.outlet},
-                      {"inlet", mass.inlet}};
-  jobs::atomic_write(out_dir / "in_mill.json", j.dump(2) + "\n");
-  write_lump_outputs(out_dir, a, j);
+  j["flywheel"] = tally(r.fly);
+  j["housing"] = tally(r.wall);
+  j["mass_places"] = {{"rotor", r.mass.rotor},
+                      {"housing", r.mass.housing},
+                      {"outlet", r.mass.outlet},
+                      {"inlet", r.mass.inlet}};
+}
 
+// The run's summary line.
+std::string in_mill_line(const nlohmann::json& in, const LumpRunResult& a, const MillRecord& r,
+                         double seconds) {
   const auto& s = a.result.summary;
   return fmt::format(
       "lump {} struck at {:.1f} m/s ({:.0f} deg): {} pieces ({} single), largest {:.1f}%, t10 "
@@ -306,10 +342,50 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
       "{:.1f}% ({} at the strike, {} later); {} flywheel and {} housing contacts; mass in the "
       "rotor region {:.0f}%, "
       "housing {:.0f}%, below the floor {:.0f}% [{:.1f} s]",
-      in.at("particle_id").get<long long>(), v_strike, a_strike, s.n_pieces, s.n_single,
+      in.at("particle_id").get<long long>(), in.at("strike_speed_m_s").get<double>(),
+      in.at("strike_angle_deg").get<double>(), s.n_pieces, s.n_single,
       100 * s.largest_mass_fraction, s.t10_percent, s.t10_resolved ? "" : " (unresolved)",
-      100 * s.broken_bond_fraction, split.at_strike, split.later, fly.n, wall.n, 100 * mass.rotor,
-      100 * mass.housing, 100 * mass.outlet, res.seconds);
+      100 * s.broken_bond_fraction, r.split.at_strike, r.split.later, r.fly.n, r.wall.n,
+      100 * r.mass.rotor, 100 * r.mass.housing, 100 * r.mass.outlet, seconds);
+}
+
+}  // namespace
+
+std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& out_dir) {
+  const auto& d = ctx.cfg.doc;
+  const auto& in = job.inputs;
+  const std::string& label = job.label;
+  const double rpm = in.at("rpm").get<double>();
+  const int repeat = in.at("repeat").get<int>();
+  const fs::path field_file = gas_field(ctx, label, rpm);
+
+  const LumpRun lr = prepare_lump_run(ctx, repeat, out_dir, label);
+  const geometry::MillGeometry g = run_geometry(d, in);
+  fs::create_directories(lr.work);
+  const geometry::StlSet stl = geometry::write_stl_set(g, lr.work / "stl");
+  const StepBound step = step_bound(d, g, lr, vec3(in.at("velocity")), omega_of(rpm));
+
+  engine::DeckRun run;
+  run.deck = ctx.cfg.project_dir / "liggghts_inputs" / "in_mill.in.tmpl";
+  run.workdir = lr.work;
+  run.np = ctx.opts.np;
+  run.job = "breakage/" + label;
+  run.vars = in_mill_vars(ctx, in, g, stl, lr, field_file, step);
+  const engine::Result res = engine::run_deck(ctx.runner, run, ctx.progress, label);
+
+  // Fragments, judged at the strike's relative speed (its specific energy).
+  const double a_strike = in.at("strike_angle_deg").get<double>();
+  const LumpRunResult a = analyse_lump_run(
+      ctx, lr, {in.at("strike_speed_m_s").get<double>(), std::clamp(a_strike, 0.0, 90.0), repeat},
+      res.seconds, label);
+  check_inside_walls(a, g, lr, label);
+  const MillRecord record = read_record(lr, a, g);
+
+  nlohmann::json j = lump_result_json(lr, a, res.seconds);
+  add_in_mill_keys(j, d, in, record);
+  jobs::atomic_write(out_dir / "in_mill.json", j.dump(2) + "\n");
+  write_lump_outputs(out_dir, a, j);
+  return in_mill_line(in, a, record, res.seconds);
 }
 
 std::string damaged_in_mill_outputs(const fs::path& dir) {
@@ -415,4 +491,4 @@ std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
   return out;
 }
 
-}  // namespace mill
+}  // namespace mill::breakage

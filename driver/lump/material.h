@@ -3,12 +3,13 @@
 // closed-form estimates.
 #pragma once
 
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "config/case_config.h"
 #include "lump/bond_parameters.h"
-#include "stages/stage.h"
 
 namespace mill {
 

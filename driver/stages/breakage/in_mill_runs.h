@@ -14,7 +14,7 @@
 
 #include "stages/stage.h"
 
-namespace mill {
+namespace mill::breakage {
 
 // True for the jobs plan_in_mill makes.
 bool is_in_mill_job(const JobSpec& job);
@@ -35,4 +35,4 @@ std::string damaged_in_mill_outputs(const std::filesystem::path& dir);
 std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
                                                        const std::vector<JobSpec>& jobs);
 
-}  // namespace mill
+}  // namespace mill::breakage

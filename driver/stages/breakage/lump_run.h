@@ -14,14 +14,14 @@
 #include <utility>
 #include <vector>
 
+#include "lump/lump_builder.h"
+#include "lump/material.h"
 #include "postprocess/breakage_results.h"
 #include "postprocess/energy_ledger.h"
 #include "postprocess/lammps_dump.h"
-#include "stages/lump_builder.h"
-#include "stages/material.h"
 #include "stages/stage.h"
 
-namespace mill {
+namespace mill::breakage {
 
 struct LumpRun {
   LumpInfo lump;
@@ -74,4 +74,4 @@ void write_lump_outputs(const std::filesystem::path& out_dir, const LumpRunResul
 // The outputs write_lump_outputs writes exist and parse: "" or the reason.
 std::string damaged_lump_outputs(const std::filesystem::path& dir);
 
-}  // namespace mill
+}  // namespace mill::breakage
