@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "atom.h"
+#include "bond_geometry.h"
 #include "comm.h"
 #include "domain.h"
 #include "error.h"
@@ -24,105 +25,13 @@
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
+using namespace mill::bond_geometry;
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kEventCols = 10;  // step time x y z mode tag_a tag_b sigma tau
 constexpr int kMaxBondsLimit = 64;
-
-// Small 3-vector helpers: dot product, cross product c = a x b, Euclidean norm.
-inline double dot3(const double *a, const double *b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-inline double norm3(const double *a) { return std::sqrt(dot3(a, a)); }
-
-// A 3-vector by value for the per-bond arithmetic: the compiler keeps its
-// components in registers (arrays written through pointers and read back
-// packed stalled store forwarding: 30 % of the bond loop in perf).
-struct Vec3 {
-  double x, y, z;
-};
-inline Vec3 load3(const double *p) { return {p[0], p[1], p[2]}; }
-inline void store3(double *p, Vec3 v) {
-  p[0] = v.x;
-  p[1] = v.y;
-  p[2] = v.z;
-}
-inline Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline Vec3 operator-(Vec3 a) { return {-a.x, -a.y, -a.z}; }
-inline Vec3 operator*(double s, Vec3 a) { return {s * a.x, s * a.y, s * a.z}; }
-inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline Vec3 cross(Vec3 a, Vec3 b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
-// Moves a stored contact-plane vector v onto the plane normal to n and spins it
-// about n by the small angle theta: the rigid-body update of the contact frame
-// used by PFC3D for the parallel bond (Potyondy & Cundall 2004, sec. 2.2; Itasca
-// PFC manual, "contact force update"). |v| is kept exactly; the spin uses the
-// second-order rotation v cos(theta) + (n x v) sin(theta) with
-// cos ~ 1 - theta^2/2, sin ~ theta (theta = spin x dt << 1 for a stable dt).
-[[gnu::always_inline]] inline Vec3 rotate_onto_plane(Vec3 v, Vec3 n, double theta) {
-  const double mag0_sq = dot(v, v);
-  // |v| < 1e-100: flush, denormal arithmetic is ~100x slower
-  if (mag0_sq < 1e-200) return {0.0, 0.0, 0.0};
-  v = v - dot(v, n) * n;
-  if (theta != 0.0) {
-    const double c = 1.0 - 0.5 * theta * theta;
-    v = c * v + theta * cross(n, v);
-  }
-  const double mag1_sq = dot(v, v);
-  if (mag1_sq > 0.0 && mag1_sq != mag0_sq) v = std::sqrt(mag0_sq / mag1_sq) * v;
-  return v;
-}
-
-// Relative motion of a bonded (or touching) pair a-b at the contact point,
-// which splits the line of centres Ra : Rb so that a rigid rotation of the
-// pair gives no relative motion there (objective shear increment).
-struct PairMotion {
-  Vec3 n;       // unit vector a -> b
-  Vec3 ra, rb;  // contact point from a and from b
-  Vec3 wa, wb;  // spins of a and b
-  Vec3 vt;      // tangential relative velocity of b's material point w.r.t. a's
-  double vn;    // normal relative velocity (> 0: separating)
-  Vec3 vrel_ab; // vb - va (centres)
-};
-[[gnu::always_inline]] inline PairMotion pair_motion(Vec3 d, double len, Vec3 va, Vec3 vb, Vec3 wa,
-                                                     Vec3 wb, double ra_s, double rb_s) {
-  PairMotion m;
-  const double inv_len = 1.0 / len;
-  m.n = inv_len * d;
-  const double arm_a = len * ra_s / (ra_s + rb_s);
-  const double arm_b = len - arm_a;
-  m.ra = arm_a * m.n;
-  m.rb = -arm_b * m.n;
-  m.wa = wa;
-  m.wb = wb;
-  m.vrel_ab = vb - va;
-  const Vec3 vrel = ((vb - va) + cross(wb, m.rb)) - cross(wa, m.ra);
-  m.vn = dot(vrel, m.n);
-  m.vt = vrel - m.vn * m.n;
-  return m;
-}
-
-// The same pair without the relative velocity at the contact point (vn, vt
-// zero): what a bond needs at the end of its step when it has no dashpots.
-[[gnu::always_inline]] inline PairMotion pair_geometry(Vec3 d, double len, Vec3 va, Vec3 vb, Vec3 wa,
-                                                       Vec3 wb, double ra_s, double rb_s) {
-  PairMotion m;
-  m.n = (1.0 / len) * d;
-  const double arm_a = len * ra_s / (ra_s + rb_s);
-  m.ra = arm_a * m.n;
-  m.rb = -(len - arm_a) * m.n;
-  m.wa = wa;
-  m.wb = wb;
-  m.vrel_ab = vb - va;
-  m.vn = 0.0;
-  m.vt = {0.0, 0.0, 0.0};
-  return m;
-}
 
 // Formats a double the way users wrote it (shortest round-trip-ish form).
 std::string fmt_num(double v) {
@@ -148,6 +57,8 @@ struct FixBondBreakable::BondResult {
   double slipped;   // taken this step by Coulomb slip of a contact [J] (advance only)
   Vec3 centre;      // bond centre (contact point)
   int mode;         // 0 intact, 1 tension, 2 shear
+  // bond/flatjoint: elements that broke this step, and bonded after it.
+  int fj_tension = 0, fj_shear = 0, fj_bonded = 0;
 };
 
 // Per-atom arrays read by evaluate_bond, fetched once per step (LIGGGHTS's
@@ -198,16 +109,34 @@ FixBondBreakable::~FixBondBreakable() {
 void FixBondBreakable::parse_args(int narg, char **arg) {
   bool have_modulus = false, have_ratio = false, have_tensile = false, have_cohesion = false;
   auto fail = [this](const std::string &msg) {
-    std::string m = "fix bond/breakable: " + msg;
+    std::string m = label() + msg;
     error->all(FLERR, m.c_str());
   };
-  const mill::StyleArgs args(error, "bond/breakable");
+  const mill::StyleArgs args(error, style);
+  flat_joint_ = std::strcmp(style, "bond/flatjoint") == 0;
   int iarg = 3;
   while (iarg < narg) {
     const std::string key = arg[iarg];
     if (iarg + 1 >= narg) fail("keyword '" + key + "' needs a value");
     const char *val = arg[iarg + 1];
-    if (key == "radius_multiplier") {
+    const bool parallel_only =
+        key == "moment_factor" || key == "broken_contact" || key == "contact_moment";
+    if (flat_joint_ && parallel_only) {
+      fail("keyword '" + key + "' is one of fix bond/breakable's parallel bonds; a flat joint " +
+           "has none (its elements carry the moments, broken elements stay as frictional " +
+           "contacts): remove it (docs/styles/fix_bond_flatjoint.md)");
+    } else if ((key == "elements" || key == "joint_friction") && !flat_joint_) {
+      fail("keyword '" + key + "' belongs to fix bond/flatjoint, not to " + style);
+    } else if (key == "elements") {
+      if (iarg + 2 >= narg) fail("keyword 'elements' needs two values: rings sectors");
+      fj_rings_ = args.integer("elements (rings)", val, 1, mill::flat_joint::kMaxElements);
+      fj_sectors_ = args.integer("elements (sectors)", arg[iarg + 2], 3,
+                                 mill::flat_joint::kMaxElements);
+      ++iarg;
+    } else if (key == "joint_friction") {
+      fj_friction_ = args.real(arg[iarg], val);
+      if (!(fj_friction_ >= 0.0)) fail("joint_friction must be >= 0, got " + std::string(val));
+    } else if (key == "radius_multiplier") {
       radius_multiplier_ = args.positive(arg[iarg], val);
     } else if (key == "modulus") {
       modulus_ = args.positive(arg[iarg], val, "Pa");
@@ -264,9 +193,14 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
       }
     } else {
       fail("unknown keyword '" + key +
-           "' (expected radius_multiplier, modulus, stiffness_ratio, tensile_strength, cohesion, "
-           "friction_angle, moment_factor, broken_contact, contact_moment, unbonded_fraction, "
-           "unbonded_seed, damping, gap, max_bonds, break_log, dump_bonds)");
+           (flat_joint_ ? "' (expected radius_multiplier, modulus, stiffness_ratio, "
+                          "tensile_strength, cohesion, friction_angle, elements, joint_friction, "
+                          "unbonded_fraction, unbonded_seed, damping, gap, max_bonds, break_log, "
+                          "dump_bonds)"
+                        : "' (expected radius_multiplier, modulus, stiffness_ratio, "
+                          "tensile_strength, cohesion, friction_angle, moment_factor, "
+                          "broken_contact, contact_moment, unbonded_fraction, unbonded_seed, "
+                          "damping, gap, max_bonds, break_log, dump_bonds)"));
     }
     iarg += 2;
   }
@@ -274,6 +208,14 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
   if (!have_ratio) fail("keyword 'stiffness_ratio' is required (kn/ks, dimensionless)");
   if (!have_tensile) fail("keyword 'tensile_strength' is required (Pa)");
   if (!have_cohesion) fail("keyword 'cohesion' is required (Pa)");
+  if (flat_joint_) {
+    if (fj_rings_ * fj_sectors_ > mill::flat_joint::kMaxElements)
+      fail("elements " + std::to_string(fj_rings_) + " x " + std::to_string(fj_sectors_) +
+           " is more than " + std::to_string(mill::flat_joint::kMaxElements) +
+           " elements per interface");
+    fj_layout_ = mill::flat_joint::make_layout(fj_rings_, fj_sectors_);
+    ncol_ = NCOL + mill::flat_joint::history_size(fj_layout_.elements());
+  }
 }
 
 // Hooks: forces after the pair style; optional periodic bond dumps.
@@ -290,16 +232,16 @@ int FixBondBreakable::setmask() {
 void FixBondBreakable::init() {
   if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
     error->all(FLERR,
-               "fix bond/breakable: requires per-atom radius, mass, omega and torque "
-               "(use 'atom_style sphere')");
+               (label() + "requires per-atom radius, mass, omega and torque "
+                "(use 'atom_style sphere')").c_str());
   if (atom->map_style == 0)
     error->all(FLERR,
-               "fix bond/breakable: needs the atom map to find bond partners; add "
-               "'atom_modify map array' before the box is created");
+               (label() + "needs the atom map to find bond partners; add "
+                "'atom_modify map array' before the box is created").c_str());
   if (!comm->ghost_velocity)
     error->all(FLERR,
-               "fix bond/breakable: ghost atoms need velocities; add 'communicate single vel yes' "
-               "(LIGGGHTS's form of 'comm_modify vel yes')");
+               (label() + "ghost atoms need velocities; add 'communicate single vel yes' "
+                "(LIGGGHTS's form of 'comm_modify vel yes')").c_str());
 
   double lo = 1e300, hi = 0.0;
   for (int i = 0; i < atom->nlocal; ++i)
@@ -316,19 +258,20 @@ void FixBondBreakable::init() {
 
   double lm = 0.0;
   for (int i = 0; i < atom->nlocal; ++i)
-    for (int k = 0; k < nbond_[i]; ++k) lm = std::max(lm, bonds_[i][k * NCOL + L0]);
+    for (int k = 0; k < nbond_[i]; ++k) lm = std::max(lm, bonds_[i][k * ncol_ + L0]);
   MPI_Allreduce(&lm, &lmax_, 1, MPI_DOUBLE, MPI_MAX, world);
 
   if (break_log_path_.size() && comm->me == 0 && !break_log_) {
     break_log_ = fopen(break_log_path_.c_str(), bonds_created_ ? "a" : "w");
     if (!break_log_) {
-      std::string m = "fix bond/breakable: cannot open break_log file '" + break_log_path_ + "'";
+      std::string m = label() + "cannot open break_log file '" + break_log_path_ + "'";
       fail_one(m);
     }
     if (!bonds_created_)
       fprintf(break_log_,
-              "# fix bond/breakable break events\n"
-              "# columns: step time[s] x[m] y[m] z[m] mode tag_i tag_j sigma[Pa] tau[Pa]\n");
+              "# fix %s break events\n"
+              "# columns: step time[s] x[m] y[m] z[m] mode tag_i tag_j sigma[Pa] %s\n",
+              style, flat_joint_ ? "tau/tau_c[-]" : "tau[Pa]");
   }
 }
 
@@ -491,6 +434,7 @@ void FixBondBreakable::create_bonds() {
   struct Candidate {
     int tag;
     double dist;
+    Vec3 d;  // lower tag -> higher tag (the flat joint's normal)
   };
   std::vector<Candidate> cand;
   for (int i = 0; i < nlocal; ++i) {
@@ -518,15 +462,15 @@ void FixBondBreakable::create_bonds() {
               bool dup = false;  // periodic images: keep the closest
               for (auto &cd : cand)
                 if (cd.tag == tag[j]) {
-                  cd.dist = std::min(cd.dist, dist);
+                  if (dist < cd.dist) cd = {tag[j], dist, load3(d)};
                   dup = true;
                 }
-              if (!dup) cand.push_back({tag[j], dist});
+              if (!dup) cand.push_back({tag[j], dist, load3(d)});
             }
           }
         }
     if (static_cast<int>(cand.size()) > max_bonds_) {
-      std::string m = "fix bond/breakable: atom " + std::to_string(tag[i]) + " has " +
+      std::string m = label() + "atom " + std::to_string(tag[i]) + " has " +
                       std::to_string(cand.size()) + " bond candidates but max_bonds is " +
                       std::to_string(max_bonds_) + "; raise max_bonds or lower gap";
       fail_one(m);
@@ -534,11 +478,15 @@ void FixBondBreakable::create_bonds() {
     std::sort(cand.begin(), cand.end(),
               [](const Candidate &p, const Candidate &q) { return p.tag < q.tag; });
     for (const auto &cd : cand) {
-      double *s = &bonds_[i][nbond_[i] * NCOL];
-      for (int k = 0; k < NCOL; ++k) s[k] = 0.0;
+      double *s = &bonds_[i][nbond_[i] * ncol_];
+      for (int k = 0; k < ncol_; ++k) s[k] = 0.0;
       s[PARTNER] = cd.tag;
       s[L0] = cd.dist;
       if (unbonded_fraction_ > 0.0 && starts_unbonded(tag[i], cd.tag)) s[STATE] = 1.0;
+      // Both ends get bitwise the same history: the canonical normal.
+      if (flat_joint_)
+        mill::flat_joint::init_history(&s[NCOL], fj_layout_, (1.0 / cd.dist) * cd.d,
+                                       s[STATE] == 0.0);
       ++nbond_[i];
     }
   }
@@ -551,7 +499,7 @@ void FixBondBreakable::create_bonds() {
       local[0] += intact_bonds(i);
       slots += nbond_[i];
       local[1] += 1.0;
-      for (int k = 0; k < nbond_[i]; ++k) local[2] = std::max(local[2], bonds_[i][k * NCOL + L0]);
+      for (int k = 0; k < nbond_[i]; ++k) local[2] = std::max(local[2], bonds_[i][k * ncol_ + L0]);
     }
   MPI_Allreduce(local, global, 2, MPI_DOUBLE, MPI_SUM, world);
   MPI_Allreduce(&local[2], &lmax_, 1, MPI_DOUBLE, MPI_MAX, world);
@@ -561,15 +509,15 @@ void FixBondBreakable::create_bonds() {
   const double coord = global[1] > 0.0 ? global[0] / global[1] : 0.0;
   char line[320];
   snprintf(line, sizeof(line),
-           "fix bond/breakable: created %.0f bonds among %.0f atoms, mean coordination %.3f "
+           "%screated %.0f bonds among %.0f atoms, mean coordination %.3f "
            "(gap < %g x min radius)",
-           nb, global[1], coord, gap_);
+           label().c_str(), nb, global[1], coord, gap_);
   message(line);
   if (unbonded_fraction_ > 0.0) {
     snprintf(line, sizeof(line),
-             "fix bond/breakable: %.0f more pairs in bonding range left unbonded "
+             "%s%.0f more pairs in bonding range left unbonded "
              "(unbonded_fraction %g): compression-only frictional contacts",
-             0.5 * (slots_all - global[0]), unbonded_fraction_);
+             label().c_str(), 0.5 * (slots_all - global[0]), unbonded_fraction_);
     message(line);
   }
 }
@@ -580,7 +528,7 @@ int FixBondBreakable::partner_index(int i, int partner_tag) const {
   int j = atom->map(partner_tag);
   if (j >= 0 && atom->tag[j] != partner_tag) j = -1;  // stale map entry (deleted atom)
   if (j < 0) {
-    std::string m = "fix bond/breakable: bond partner " + std::to_string(partner_tag) +
+    std::string m = label() + "bond partner " + std::to_string(partner_tag) +
                     " of atom " + std::to_string(atom->tag[i]) +
                     " is neither owned nor a ghost on this rank (atom lost, or ghost cutoff too "
                     "short: raise 'communicate single cutoff')";
@@ -594,7 +542,7 @@ int FixBondBreakable::partner_index(int i, int partner_tag) const {
 int FixBondBreakable::intact_bonds(int i) const {
   if (!contacts_on()) return nbond_[i];
   int n = 0;
-  for (int k = 0; k < nbond_[i]; ++k) n += bonds_[i][k * NCOL + STATE] == 0.0;
+  for (int k = 0; k < nbond_[i]; ++k) n += bonds_[i][k * ncol_ + STATE] == 0.0;
   return n;
 }
 
@@ -615,14 +563,14 @@ int FixBondBreakable::find_slot(int i, int partner_tag) const {
   const double key = partner_tag;  // tags are stored exactly as doubles
   const double *row = bonds_[i];
   for (int k = 0; k < nbond_[i]; ++k)
-    if (row[k * NCOL + PARTNER] == key) return k;
+    if (row[k * ncol_ + PARTNER] == key) return k;
   return -1;
 }
 
 // Removes slot k of atom i by moving the last slot into it.
 void FixBondBreakable::remove_slot(int i, int k) {
   const int last = nbond_[i] - 1;
-  if (k != last) std::memcpy(&bonds_[i][k * NCOL], &bonds_[i][last * NCOL], NCOL * sizeof(double));
+  if (k != last) std::memcpy(&bonds_[i][k * ncol_], &bonds_[i][last * ncol_], ncol_ * sizeof(double));
   nbond_[i] = last;
 }
 
@@ -852,6 +800,72 @@ inline bool FixBondBreakable::evaluate_contact(const AtomArrays &at, ListedBond 
   return true;
 }
 
+// bond/flatjoint: the interface of a pair (flat_joint.h, Potyondy 2012), its
+// step's increments taken at the midpoint as for a parallel bond
+// (evaluate_bond): the normal and the contact point's relative motion at
+// x - v dt/2, the frame's spin the mean spin of the two grains about n.
+void FixBondBreakable::evaluate_flat_joint(const AtomArrays &at, ListedBond &bond, bool advance,
+                                           BondResult &out) const {
+  const int a = bond.a, b = bond.b;
+  const Vec3 va = load3(at.v[a]), vb = load3(at.v[b]);
+  const Vec3 wa = load3(at.omega[a]), wb = load3(at.omega[b]);
+  const Vec3 d = load3(at.x[b]) - load3(at.x[a]);
+  const double len = std::sqrt(dot(d, d));
+  const bool dashpots = damping_ > 0.0 && bond.state == 0.0;
+  const PairMotion m = dashpots ? pair_motion(d, len, va, vb, wa, wb, at.radius[a], at.radius[b])
+                                : pair_geometry(d, len, va, vb, wa, wb, at.radius[a], at.radius[b]);
+  const Vec3 dmid = d - (0.5 * at.dt) * m.vrel_ab;
+  const PairMotion h =
+      pair_motion(dmid, std::sqrt(dot(dmid, dmid)), va, vb, wa, wb, at.radius[a], at.radius[b]);
+  mill::flat_joint::Step st;
+  st.n_mid = h.n;
+  st.n_end = m.n;
+  st.du_shear = at.dt * h.vt;
+  st.wrel = wb - wa;
+  st.dtheta = at.dt * st.wrel;
+  st.spin = 0.5 * (dot(wa, m.n) + dot(wb, m.n)) * at.dt;
+  st.vrel = h.vt + h.vn * h.n;
+  st.dt = at.dt;
+  st.stretch = len - bond.l0;
+  st.advance = advance;
+  mill::flat_joint::Params p;
+  p.kn = bond.kna * bond.inv_area;
+  p.ks = bond.ksa * bond.inv_area;
+  p.radius = bond.rbond;
+  p.tensile = tensile_strength_;
+  p.cohesion = cohesion_;
+  p.tan_phi = tan_friction_;
+  p.mu = fj_friction_ >= 0.0 ? fj_friction_ : tan_friction_;
+  const mill::flat_joint::Result r = mill::flat_joint::update(bond.fj, fj_layout_, p, st);
+  // Optional dashpots on the interface while it holds (as a parallel bond's:
+  // on the contact point's relative velocity, not part of the stresses).
+  out.fdash = {0.0, 0.0, 0.0};
+  if (dashpots) out.fdash = -(bond.cn * m.vn * m.n + bond.cs * m.vt);
+  const Vec3 fb = r.force_b + out.fdash;
+  out.fa = -fb;
+  out.ta = cross(m.ra, out.fa) - r.moment_b;
+  out.tb = cross(m.rb, fb) + r.moment_b;
+  out.energy = r.energy;
+  out.slipped = r.slipped;
+  out.released = r.released;
+  out.stretch = st.stretch;
+  out.sigma = r.sigma_max;
+  out.tau = r.tau_ratio;
+  out.strength = 1.0;
+  out.centre = load3(at.x[a]) + m.ra;
+  out.mode = 0;
+  out.fj_tension = r.broke_tension;
+  out.fj_shear = r.broke_shear;
+  out.fj_bonded = r.bonded;
+}
+
+// A pair whose interface is fully broken has separated past its bonding
+// range, L0 + g min(Ri, Rj): the interface is dropped.
+bool FixBondBreakable::separated(const AtomArrays &at, const ListedBond &bond) const {
+  const Vec3 d = load3(at.x[bond.b]) - load3(at.x[bond.a]);
+  return dot(d, d) > bond.drop_len * bond.drop_len;
+}
+
 // True while the cached bond list still matches the atom arrays: no
 // neighbour-list build (the only time LIGGGHTS exchanges, sorts or re-ghosts
 // atoms), no break and no change of time step since it was built.
@@ -869,13 +883,13 @@ bool FixBondBreakable::list_current() const {
 void FixBondBreakable::store_history() {
   if (!history_dirty_) return;
   for (const ListedBond &lb : list_) {
-    double *si = &bonds_[lb.i][lb.slot_i * NCOL];
+    double *si = &bonds_[lb.i][lb.slot_i * ncol_];
     store3(&si[FS], load3(lb.fs));
     store3(&si[MB], load3(lb.mb));
     si[MT] = lb.mt;
     si[STATE] = lb.state;
-    if (lb.j >= 0) std::memcpy(&bonds_[lb.j][lb.slot_j * NCOL + FS], &si[FS],
-                               (NCOL - FS) * sizeof(double));
+    if (lb.j >= 0) std::memcpy(&bonds_[lb.j][lb.slot_j * ncol_ + FS], &si[FS],
+                               (ncol_ - FS) * sizeof(double));
   }
   history_dirty_ = false;
 }
@@ -894,7 +908,7 @@ void FixBondBreakable::build_bond_list() {
   list_.clear();
   for (int i = 0; i < nlocal; ++i) {
     for (int k = nbond_[i] - 1; k >= 0; --k) {
-      const double *slot = &bonds_[i][k * NCOL];
+      const double *slot = &bonds_[i][k * ncol_];
       const int ptag = static_cast<int>(slot[PARTNER]);
       int jloc = atom->map(ptag);
       if (jloc >= 0 && tag[jloc] != ptag) jloc = -1;  // stale map entry
@@ -907,7 +921,7 @@ void FixBondBreakable::build_bond_list() {
       if (partner_local) {
         jslot = find_slot(jloc, tag[i]);
         if (jslot < 0) {
-          std::string m = "fix bond/breakable: internal error, bond " + std::to_string(tag[i]) +
+          std::string m = label() + "internal error, bond " + std::to_string(tag[i]) +
                           "-" + std::to_string(ptag) + " stored on one end only";
           fail_one(m);
         }
@@ -947,6 +961,7 @@ void FixBondBreakable::build_bond_list() {
       lb.cn = 2.0 * damping_ * std::sqrt(ma * mbm / (ma + mbm) * kn * area);
       lb.cs = lb.cn * std::sqrt(inv_ratio_);
       lb.drop_len = slot[L0] + gap_ * std::min(radius[lb.a], radius[lb.b]);
+      lb.fj = flat_joint_ ? &bonds_[i][k * ncol_ + NCOL] : nullptr;
       list_.push_back(lb);
     }
   }
@@ -1005,13 +1020,46 @@ void FixBondBreakable::compute_bonds(bool advance) {
   };
   // Queues the slots of list entry lb for removal after the loop (by tag).
   auto remove_later = [&](const ListedBond &lb) {
-    const int ptag = static_cast<int>(bonds_[lb.i][lb.slot_i * NCOL + PARTNER]);
+    const int ptag = static_cast<int>(bonds_[lb.i][lb.slot_i * ncol_ + PARTNER]);
     const int brk[4] = {lb.i, lb.j, tag[lb.i], ptag};
     broken_.insert(broken_.end(), brk, brk + 4);
   };
 
   const int nlisted = static_cast<int>(list_.size());
-  for (int e = 0; e < nlisted; ++e) {
+  for (int e = 0; e < nlisted && flat_joint_; ++e) {
+    // bond/flatjoint: every interface, bonded or not, through its elements;
+    // one whose elements are all broken stays until the pair separates.
+    ListedBond &lb = list_[e];
+    if (lb.state != 0.0 && separated(at, lb)) {
+      if (advance) remove_later(lb);
+      continue;
+    }
+    evaluate_flat_joint(at, lb, advance, r);
+    apply(lb);
+    if (lb.state == 0.0 && r.fj_bonded == 0) contact_.push_back(e);  // all elements broken
+    if (!lb.i_lower) continue;  // counted once: by the owner of the lower tag
+    stored += r.energy;
+    ledger_.friction += r.slipped;
+    ledger_.released += r.released;
+    if (damping_ > 0.0) store3(&dash_[3 * e], r.fdash);
+    local[1] += r.fj_tension;
+    local[2] += r.fj_shear;
+    if (lb.state == 0.0 && r.fj_bonded > 0) local[0] += 1.0;
+    if (advance && r.fj_tension + r.fj_shear > 0) {
+      const double ev[kEventCols] = {static_cast<double>(update->ntimestep),
+                                     update->get_cur_time(),
+                                     r.centre.x,
+                                     r.centre.y,
+                                     r.centre.z,
+                                     r.fj_tension > 0 ? 1.0 : 2.0,
+                                     static_cast<double>(tag[lb.i]),
+                                     bonds_[lb.i][lb.slot_i * ncol_ + PARTNER],
+                                     r.sigma,
+                                     r.tau};
+      events_.insert(events_.end(), ev, ev + kEventCols);
+    }
+  }
+  for (int e = 0; e < nlisted && !flat_joint_; ++e) {
     ListedBond &lb = list_[e];
     if (lb.state != 0.0) {  // a broken bond kept as a contact
       if (evaluate_contact(at, lb, advance, r)) {
@@ -1040,7 +1088,7 @@ void FixBondBreakable::compute_bonds(bool advance) {
             r.centre.z,
             static_cast<double>(r.mode),
             static_cast<double>(tag[lb.i]),
-            bonds_[lb.i][lb.slot_i * NCOL + PARTNER],
+            bonds_[lb.i][lb.slot_i * ncol_ + PARTNER],
             r.sigma,
             r.tau};
         events_.insert(events_.end(), ev, ev + kEventCols);
@@ -1071,9 +1119,14 @@ void FixBondBreakable::compute_bonds(bool advance) {
   }
 
   // Broken bonds become contacts (broken_contact yes): state 1, and the stored
-  // shear force and moments start again from zero.
+  // shear force and moments start again from zero. (A flat joint whose
+  // elements all broke keeps its history: state 1 only.)
   for (const int e : contact_) {
     ListedBond &lb = list_[e];
+    if (flat_joint_) {
+      lb.state = 1.0;
+      continue;
+    }
     store3(lb.fs, {0.0, 0.0, 0.0});
     store3(lb.mb, {0.0, 0.0, 0.0});
     lb.mt = 0.0;
@@ -1134,8 +1187,8 @@ void FixBondBreakable::write_bond_dump() {
   std::vector<int> mine;
   for (int i = 0; i < atom->nlocal; ++i)
     for (int k = 0; k < nbond_[i]; ++k) {
-      const int p = static_cast<int>(bonds_[i][k * NCOL + PARTNER]);
-      if (bonds_[i][k * NCOL + STATE] != 0.0) continue;  // a contact, not a bond
+      const int p = static_cast<int>(bonds_[i][k * ncol_ + PARTNER]);
+      if (bonds_[i][k * ncol_ + STATE] != 0.0) continue;  // a contact, not a bond
       if (atom->tag[i] < p) {
         mine.push_back(atom->tag[i]);
         mine.push_back(p);
@@ -1165,7 +1218,7 @@ void FixBondBreakable::write_bond_dump() {
   const std::string tmp = path + ".tmp";
   FILE *fp = fopen(tmp.c_str(), "w");
   if (!fp) {
-    std::string m = "fix bond/breakable: cannot write dump_bonds file '" + tmp + "'";
+    std::string m = label() + "cannot write dump_bonds file '" + tmp + "'";
     fail_one(m);
   }
   fprintf(fp, "# fix bond/breakable intact bonds\n# step " BIGINT_FORMAT "\n", update->ntimestep);
@@ -1173,7 +1226,7 @@ void FixBondBreakable::write_bond_dump() {
   for (const auto &p : pairs) fprintf(fp, "%d %d\n", p.first, p.second);
   fclose(fp);
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::string m = "fix bond/breakable: cannot rename '" + tmp + "' to '" + path + "'";
+    std::string m = label() + "cannot rename '" + tmp + "' to '" + path + "'";
     fail_one(m);
   }
 }
@@ -1196,8 +1249,8 @@ void FixBondBreakable::estimate_time_step() {
   for (int i = 0; i < atom->nlocal; ++i) {
     double sum = 0.0;
     for (int k = 0; k < nbond_[i]; ++k) {
-      const int j = partner_index(i, static_cast<int>(bonds_[i][k * NCOL + PARTNER]));
-      const double l0 = bonds_[i][k * NCOL + L0];
+      const int j = partner_index(i, static_cast<int>(bonds_[i][k * ncol_ + PARTNER]));
+      const double l0 = bonds_[i][k * ncol_ + L0];
       const double rb = radius_multiplier_ * std::min(radius[i], radius[j]);
       const double area = kPi * rb * rb, inertia = 0.25 * area * rb * rb;
       const double kn = modulus_ / l0, ks = kn / stiffness_ratio_;
@@ -1225,13 +1278,13 @@ void FixBondBreakable::estimate_time_step() {
   dt_crit_ = 2.0 / std::sqrt(global);
   char line[256];
   snprintf(line, sizeof(line),
-           "fix bond/breakable: critical time step of bond springs %.4g s; time step %.4g s",
-           dt_crit_, update->dt);
+           "%scritical time step of bond springs %.4g s; time step %.4g s",
+           label().c_str(), dt_crit_, update->dt);
   message(line);
   if (update->dt > dt_crit_ && comm->me == 0) {
     snprintf(line, sizeof(line),
-             "fix bond/breakable: time step %g s exceeds the bond critical time step %g s",
-             update->dt, dt_crit_);
+             "%stime step %g s exceeds the bond critical time step %g s",
+             label().c_str(), update->dt, dt_crit_);
     error->warning(FLERR, line);
   }
 }
@@ -1278,7 +1331,8 @@ void FixBondBreakable::write_restart(FILE *fp) {
                          broken_contact_ ? 1.0 : 0.0,
                          unbonded_fraction_,
                          static_cast<double>(unbonded_seed_),
-                         contact_moment_ ? 1.0 : 0.0};
+                         contact_moment_ ? 1.0 : 0.0,
+                         static_cast<double>(ncol_)};
   const int n = sizeof(list) / sizeof(list[0]);
   if (comm->me == 0) {
     int size = n * sizeof(double);
@@ -1301,14 +1355,21 @@ void FixBondBreakable::restart(char *buf) {
                            list[5], list[6], list[7], list[13]};
   for (int k = 0; k < 9; ++k)
     if (*mine[k] != theirs[k] && comm->me == 0) {
-      std::string m = std::string("fix bond/breakable: ") + names[k] + " " + fmt_num(*mine[k]) +
+      std::string m = label() + names[k] + " " + fmt_num(*mine[k]) +
                       " differs from the restart file (" + fmt_num(theirs[k]) +
                       "); using the deck's value";
       error->warning(FLERR, m.c_str());
     }
   if (static_cast<int>(list[8]) > max_bonds_) {
-    std::string m = "fix bond/breakable: max_bonds " + std::to_string(max_bonds_) +
+    std::string m = label() + "max_bonds " + std::to_string(max_bonds_) +
                     " is smaller than in the restart file (" + fmt_num(list[8]) + ")";
+    error->all(FLERR, m.c_str());
+  }
+  if (static_cast<int>(list[18]) != ncol_) {
+    // A slot's columns: the bond model and, for a flat joint, its elements.
+    std::string m = label() + "the restart file holds bonds of " + fmt_num(list[18]) +
+                    " columns, this fix " + std::to_string(ncol_) +
+                    ": give the same style (and elements) as the run that wrote it";
     error->all(FLERR, m.c_str());
   }
   bonds_created_ = static_cast<int>(list[9]);
@@ -1316,11 +1377,12 @@ void FixBondBreakable::restart(char *buf) {
   broken_shear_ = list[11];
   lmax_ = list[12];
   if (list[15] != unbonded_fraction_ && comm->me == 0)
-    error->warning(FLERR, "fix bond/breakable: unbonded_fraction differs from the restart file; "
-                          "the pairs were chosen when the bonds were created and are kept");
+    error->warning(FLERR, (label() + "unbonded_fraction differs from the restart file; "
+                                     "the pairs were chosen when the bonds were created and are kept")
+                                        .c_str());
   if ((list[14] != 0.0) != broken_contact_) {
     // Contacts stored in the file would be read as bonds (or the reverse).
-    std::string m = std::string("fix bond/breakable: broken_contact ") +
+    std::string m = label() + "broken_contact " +
                     (broken_contact_ ? "yes" : "no") + " differs from the restart file (" +
                     (list[14] != 0.0 ? "yes" : "no") + "); give the same value";
     error->all(FLERR, m.c_str());
@@ -1331,7 +1393,7 @@ void FixBondBreakable::restart(char *buf) {
 void FixBondBreakable::grow_arrays(int nmax) {
   store_history();  // the list's slot indices stay valid across the reallocation
   memory->grow(nbond_, nmax, "bond/breakable:nbond");
-  memory->grow(bonds_, nmax, max_bonds_ * NCOL, "bond/breakable:bonds");
+  memory->grow(bonds_, nmax, max_bonds_ * ncol_, "bond/breakable:bonds");
   memory->grow(count_, nmax, "bond/breakable:count");
   for (int i = nmax_; i < nmax; ++i) {
     nbond_[i] = 0;
@@ -1347,7 +1409,7 @@ void FixBondBreakable::copy_arrays(int i, int j, int /*delflag*/) {
   store_history();  // normally a no-op: pre_exchange already stored it
   nbond_[j] = nbond_[i];
   count_[j] = count_[i];
-  std::memcpy(bonds_[j], bonds_[i], nbond_[i] * NCOL * sizeof(double));
+  std::memcpy(bonds_[j], bonds_[i], nbond_[i] * ncol_ * sizeof(double));
 }
 
 // A newly created atom has no bonds.
@@ -1361,26 +1423,26 @@ void FixBondBreakable::set_arrays(int i) {
 int FixBondBreakable::pack_exchange(int i, double *buf) {
   store_history();  // normally a no-op: pre_exchange already stored it
   buf[0] = nbond_[i];
-  std::memcpy(&buf[1], bonds_[i], nbond_[i] * NCOL * sizeof(double));
-  return 1 + nbond_[i] * NCOL;
+  std::memcpy(&buf[1], bonds_[i], nbond_[i] * ncol_ * sizeof(double));
+  return 1 + nbond_[i] * ncol_;
 }
 
 // Same columns as pack_exchange.
 int FixBondBreakable::unpack_exchange(int nlocal, double *buf) {
   if (nlocal >= nmax_) grow_arrays(atom->nmax);
   nbond_[nlocal] = static_cast<int>(buf[0]);
-  std::memcpy(bonds_[nlocal], &buf[1], nbond_[nlocal] * NCOL * sizeof(double));
+  std::memcpy(bonds_[nlocal], &buf[1], nbond_[nlocal] * ncol_ * sizeof(double));
   count_[nlocal] = intact_bonds(nlocal);
-  return 1 + nbond_[nlocal] * NCOL;
+  return 1 + nbond_[nlocal] * ncol_;
 }
 
 // Restart columns: size, nbond, then nbond x (PARTNER L0 FS[3] MB[3] MT STATE).
 int FixBondBreakable::pack_restart(int i, double *buf) {
   store_history();  // a restart written during a run (output after post_force)
-  buf[0] = 2 + nbond_[i] * NCOL;
+  buf[0] = 2 + nbond_[i] * ncol_;
   buf[1] = nbond_[i];
-  std::memcpy(&buf[2], bonds_[i], nbond_[i] * NCOL * sizeof(double));
-  return 2 + nbond_[i] * NCOL;
+  std::memcpy(&buf[2], bonds_[i], nbond_[i] * ncol_ * sizeof(double));
+  return 2 + nbond_[i] * ncol_;
 }
 
 // Reads this fix's columns of atom nlocal from atom->extra (same order).
@@ -1391,23 +1453,23 @@ void FixBondBreakable::unpack_restart(int nlocal, int nth) {
   m++;
   const int nb = static_cast<int>(extra[nlocal][m++]);
   if (nb > max_bonds_) {
-    std::string m2 = "fix bond/breakable: restart atom has " + std::to_string(nb) +
+    std::string m2 = label() + "restart atom has " + std::to_string(nb) +
                      " bonds, more than max_bonds " + std::to_string(max_bonds_);
     fail_one(m2);
   }
   nbond_[nlocal] = nb;
-  std::memcpy(bonds_[nlocal], &extra[nlocal][m], nb * NCOL * sizeof(double));
+  std::memcpy(bonds_[nlocal], &extra[nlocal][m], nb * ncol_ * sizeof(double));
   count_[nlocal] = intact_bonds(nlocal);
 }
 
 // Restart size of atom nlocal.
-int FixBondBreakable::size_restart(int nlocal) { return 2 + nbond_[nlocal] * NCOL; }
+int FixBondBreakable::size_restart(int nlocal) { return 2 + nbond_[nlocal] * ncol_; }
 
 // Largest restart size of any atom.
-int FixBondBreakable::maxsize_restart() { return 2 + max_bonds_ * NCOL; }
+int FixBondBreakable::maxsize_restart() { return 2 + max_bonds_ * ncol_; }
 
 // Bytes of per-atom storage and of the bond list.
 double FixBondBreakable::memory_usage() {
-  return static_cast<double>(nmax_) * (sizeof(int) + sizeof(double) * (1 + max_bonds_ * NCOL)) +
+  return static_cast<double>(nmax_) * (sizeof(int) + sizeof(double) * (1 + max_bonds_ * ncol_)) +
          static_cast<double>(list_.capacity()) * sizeof(ListedBond);
 }

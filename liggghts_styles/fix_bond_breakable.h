@@ -21,6 +21,7 @@
 
 #include "energy_terms.h"
 #include "fix.h"
+#include "flat_joint.h"
 
 namespace LAMMPS_NS {
 
@@ -60,6 +61,9 @@ class FixBondBreakable : public Fix {
   // Per-bond columns stored per atom and slot: partner tag, initial length L0,
   // shear force (3), bending moment (3), twisting moment (1), state (0 intact
   // bond, 1 broken bond kept as a compression-only contact). Canonical frame.
+  // bond/flatjoint appends the interface's history (flat_joint.h) at NCOL;
+  // a slot is then ncol_ columns wide, and its state is 1 once every element
+  // of the interface is broken.
   enum Column { PARTNER = 0, L0, FS, MB = FS + 3, MT = MB + 3, STATE, NCOL };
 
   // This rank's share of the bonds' energy terms [J] (bonds computed here,
@@ -85,6 +89,17 @@ class FixBondBreakable : public Fix {
   const std::vector<double> &ledger_forces() const { return fbond_; }
 
  private:
+  // "fix <style>: ", the start of every message.
+  std::string label() const { return std::string("fix ") + style + ": "; }
+
+  // bond/flatjoint (docs/styles/fix_bond_flatjoint.md): each bond is a
+  // flat-joint interface of elements instead of a parallel bond.
+  bool flat_joint_ = false;
+  int fj_rings_ = 1, fj_sectors_ = 3;  // elements: rings x sectors
+  double fj_friction_ = -1.0;          // mu of broken elements (< 0: tan(friction_angle))
+  mill::flat_joint::Layout fj_layout_;
+  int ncol_ = NCOL;  // columns of a slot
+
   // Parameters (SI units, see the doc page).
   double radius_multiplier_ = 1.0;  // lambda, bond radius = lambda min(Ri,Rj)  [-]
   double modulus_ = 0.0;            // E_b, bond modulus                          [Pa]
@@ -154,6 +169,7 @@ class FixBondBreakable : public Fix {
     double kni, ksj;                      // kn I, ks J [N m]
     double cn, cs;                        // dashpots (damping > 0) [N s/m]
     double drop_len;                      // a contact is dropped beyond this length [m]
+    double *fj;  // bond/flatjoint: the interface's history, in i's slot (mirrored by store_history)
   };
   std::vector<ListedBond> list_;
   bool list_valid_ = false;
@@ -187,11 +203,14 @@ class FixBondBreakable : public Fix {
   void evaluate_bond(const AtomArrays &at, ListedBond &bond, bool advance, BondResult &out) const;
   bool evaluate_contact(const AtomArrays &at, ListedBond &bond, bool advance,
                         BondResult &out) const;
+  void evaluate_flat_joint(const AtomArrays &at, ListedBond &bond, bool advance,
+                           BondResult &out) const;
+  bool separated(const AtomArrays &at, const ListedBond &bond) const;
   void store_history();
   void remove_slot(int i, int slot);
   int find_slot(int i, int partner_tag) const;
   int intact_bonds(int i) const;
-  bool contacts_on() const { return broken_contact_ || unbonded_fraction_ > 0.0; }
+  bool contacts_on() const { return flat_joint_ || broken_contact_ || unbonded_fraction_ > 0.0; }
   bool starts_unbonded(int tag_a, int tag_b) const;
   int partner_index(int i, int partner_tag) const;
   void estimate_time_step();

@@ -41,9 +41,9 @@ constexpr const char *kColumnNames =
 constexpr double kPi = 3.14159265358979323846;
 
 // Styles that add forces in post_force: the ledger must come before them.
-constexpr const char *kForceStyles[] = {"bond/breakable", "wall/halfspace", "wall/gran",
-                                        "fluid/drag",     "gravity",        "addforce",
-                                        "setforce"};
+constexpr const char *kForceStyles[] = {"bond/breakable", "bond/flatjoint", "wall/halfspace",
+                                        "wall/gran",      "fluid/drag",     "gravity",
+                                        "addforce",       "setforce"};
 
 }  // namespace
 
@@ -137,7 +137,8 @@ void FixEnergyLedger::init() {
     bonds_ = dynamic_cast<FixBondBreakable *>(modify->find_fix_id(bond_id_.c_str()));
     if (!bonds_)
       error->all(FLERR,
-                 ("fix energy/ledger: bonds " + bond_id_ + ": no fix bond/breakable with that ID")
+                 ("fix energy/ledger: bonds " + bond_id_ +
+                  ": no fix bond/breakable or bond/flatjoint with that ID")
                      .c_str());
   }
   if (!wall_id_.empty()) {

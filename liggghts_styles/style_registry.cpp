@@ -3,6 +3,7 @@
 #include <map>
 
 #include "fix_bond_breakable.h"
+#include "fix_bond_flatjoint.h"
 #include "fix_energy_ledger.h"
 #include "fix_energy_work.h"
 #include "fix_fluid_drag.h"
@@ -47,6 +48,8 @@ std::vector<std::string> register_mill_styles(LAMMPS_NS::LAMMPS *lmp) {
   using LAMMPS_NS::FixBondBreakable;
   (*fix_map)[FixBondBreakable::style_name()] = &create_fix<FixBondBreakable>;
   names.emplace_back(LAMMPS_NS::FixBondBreakable::style_name());
+  (*fix_map)[LAMMPS_NS::FixBondFlatJoint::style_name()] = &create_fix<LAMMPS_NS::FixBondFlatJoint>;
+  names.emplace_back(LAMMPS_NS::FixBondFlatJoint::style_name());
   (*fix_map)[LAMMPS_NS::FixFluidDrag::style_name()] = &create_fix<LAMMPS_NS::FixFluidDrag>;
   names.emplace_back(LAMMPS_NS::FixFluidDrag::style_name());
   (*fix_map)[LAMMPS_NS::FixImpactRecorder::style_name()] =

@@ -17,6 +17,17 @@ std::string bond_fix(const std::string &extra, double sigma_t, double cohesion) 
   return s.str();
 }
 
+std::string flat_joint_fix(const std::string &extra, double sigma_t, double cohesion, int rings,
+                           int sectors) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "fix bonds all bond/flatjoint radius_multiplier 1.0 modulus " << kEb << " stiffness_ratio "
+    << kRatio << " tensile_strength " << sigma_t << " cohesion " << cohesion << " friction_angle "
+    << kPhiDeg << " gap " << kGap << " max_bonds 16 elements " << rings << " " << sectors << " "
+    << extra << "\n";
+  return s.str();
+}
+
 std::string head_split_x(double half_box) {
   std::string head = deck_head(half_box);
   const std::string comm_line = "communicate single vel yes\n";

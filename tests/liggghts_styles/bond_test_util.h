@@ -40,6 +40,11 @@ double sphere_inertia(double r);
 std::string bond_fix(const std::string &extra = "", double sigma_t = kSigmaT,
                      double cohesion = kCohesion);
 
+// The same bond as a flat joint (fix bond/flatjoint, `elements rings
+// sectors`), with extra keywords.
+std::string flat_joint_fix(const std::string &extra = "", double sigma_t = kSigmaT,
+                           double cohesion = kCohesion, int rings = 2, int sectors = 4);
+
 // One sphere of the data file.
 struct Sphere {
   std::array<double, 3> x{};  // position [m]

@@ -69,12 +69,15 @@ TEST(BondPair, AxialOscillationPeriod) {
 
 // Runs a pair whose atom 2 is moved at velocity (vx, vy, 0) with atom 1 held;
 // returns the fix print rows (t |F2| intact tension shear).
+// `fix` replaces the bond/breakable line (e.g. flat_joint_fix()).
 std::vector<std::vector<double>> run_prescribed_pair(const std::string &dir, double vx, double vy,
-                                                     int steps, double dt) {
+                                                     int steps, double dt,
+                                                     const std::string &fix = "") {
   std::ostringstream d;
   d.precision(17);
   d << deck_head(0.01) << pair_atoms()
-    << bond_fix("break_log breaks.txt dump_bonds bonds_*.txt every 500") << "fix mv a2 move linear "
+    << (fix.empty() ? bond_fix("break_log breaks.txt dump_bonds bonds_*.txt every 500") : fix)
+    << "fix mv a2 move linear "
     << vx << " " << vy << " 0\n"
     << "timestep " << dt << "\n"
     << "variable t equal time\n"
@@ -88,17 +91,22 @@ std::vector<std::vector<double>> run_prescribed_pair(const std::string &dir, dou
   return read_table(dir + "/force.txt");
 }
 
+// The peak of |F| (column 1) against `expected`, printed and checked to 1 %.
+void expect_peak_force(const std::vector<std::vector<double>> &rows, double expected,
+                       const char *what) {
+  ASSERT_FALSE(rows.empty());
+  double fmax = 0.0;
+  for (const auto &row : rows) fmax = std::max(fmax, row[1]);
+  std::printf("%s: peak force %.6g N, expected %.6g N, rel. error %.3e (tol 1e-2)\n", what, fmax,
+              expected, std::fabs(fmax / expected - 1.0));
+  EXPECT_NEAR(fmax / expected, 1.0, 0.01);
+}
+
 // Slow pull: the bond breaks in tension when |F| reaches sigma_t A. Tolerance 1 %.
 TEST(BondPair, SlowPullBreaksAtTensileStrength) {
   const std::string dir = make_run_dir("pull");
   const auto rows = run_prescribed_pair(dir, 0.2, 0.0, 2000, 1e-8);
-  ASSERT_FALSE(rows.empty());
-  double fmax = 0.0;
-  for (const auto &row : rows) fmax = std::max(fmax, row[1]);
-  const double expected = kSigmaT * kArea;
-  std::printf("pull: peak bond force %.6g N, sigma_t A %.6g N, rel. error %.3e (tol 1e-2)\n", fmax,
-              expected, std::fabs(fmax / expected - 1.0));
-  EXPECT_NEAR(fmax / expected, 1.0, 0.01);
+  expect_peak_force(rows, kSigmaT * kArea, "pull");
   EXPECT_EQ(rows.back()[2], 0.0) << "bond still intact at the end";
   EXPECT_EQ(rows.back()[3], 1.0) << "not broken in tension";
   EXPECT_EQ(rows.back()[4], 0.0);
@@ -123,13 +131,7 @@ TEST(BondPair, SlowPullBreaksAtTensileStrength) {
 TEST(BondPair, SlowShearBreaksAtShearStrength) {
   const std::string dir = make_run_dir("shear");
   const auto rows = run_prescribed_pair(dir, 0.0, 0.5, 2000, 1e-8);
-  ASSERT_FALSE(rows.empty());
-  double fmax = 0.0;
-  for (const auto &row : rows) fmax = std::max(fmax, row[1]);
-  const double expected = kCohesion * kArea;
-  std::printf("shear: peak bond force %.6g N, c A %.6g N, rel. error %.3e (tol 1e-2)\n", fmax,
-              expected, std::fabs(fmax / expected - 1.0));
-  EXPECT_NEAR(fmax / expected, 1.0, 0.01);
+  expect_peak_force(rows, kCohesion * kArea, "shear");
   EXPECT_EQ(rows.back()[2], 0.0) << "bond still intact at the end";
   EXPECT_EQ(rows.back()[3], 0.0);
   EXPECT_EQ(rows.back()[4], 1.0) << "not broken in shear";
@@ -306,21 +308,23 @@ const char *kBurstFix =
 // end of step 1000, while the fix holds the bond history in its bond list),
 // not by write_restart between runs. (LIGGGHTS reneighbours on a restart step,
 // so the fix's pre_exchange has stored the history by then.)
-void check_restart(int np_first, int np_second, double tol, bool during_run = false) {
-  const std::string dir = make_run_dir("restart" + std::to_string(np_first) +
-                                       std::to_string(np_second) + (during_run ? "r" : ""));
+void check_restart(int np_first, int np_second, double tol, bool during_run = false,
+                   const std::string &fix = kBurstFix) {
+  const std::string dir =
+      make_run_dir("restart" + std::to_string(np_first) + std::to_string(np_second) +
+                   (during_run ? "r" : "") + (fix == kBurstFix ? "" : "fj"));
   const std::string tail =
       "variable nb equal f_bonds[2]\nthermo_style custom step atoms f_bonds[1] f_bonds[2]\n"
       "thermo 500\n";
   std::ostringstream straight, first, second;
   straight << head_split_x(0.05) << burst_setup() << "fix integr all nve/sphere\n"
-           << kBurstFix << "timestep 5e-8\n"
+           << fix << "timestep 5e-8\n"
            << tail << "run 2000\n"
            << "print \"${nb}\" file straight_nb.txt\n"
            << "write_dump all custom straight.dump id x y z modify format \"%d %.17g %.17g "
               "%.17g\"\n";
   first << head_split_x(0.05) << burst_setup() << "fix integr all nve/sphere\n"
-        << kBurstFix << "timestep 5e-8\n"
+        << fix << "timestep 5e-8\n"
         << tail
         << (during_run ? "restart 1000 mid.restart\nrun 1500\n" : "run 1000\nwrite_restart mid.restart\n");
   // `restart N file` appends the step to the file name.
@@ -334,7 +338,7 @@ void check_restart(int np_first, int np_second, double tol, bool during_run = fa
          << "fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n"
          << "pair_style gran model hertz tangential history\npair_coeff * *\n"
          << "fix integr all nve/sphere\n"
-         << kBurstFix << "timestep 5e-8\n"
+         << fix << "timestep 5e-8\n"
          << tail << "run 1000\n"
          << "print \"${nb}\" file restart_nb.txt\n"
          << "write_dump all custom restart.dump id x y z modify format \"%d %.17g %.17g "
@@ -393,8 +397,13 @@ namespace {
 // A bonded simple-cubic ball (~300 elements) hitting a wall at 10 m/s; the
 // processor split (x) runs through the ball. Returns {bonds at start, broken
 // at end, fragments at end}.
-std::array<double, 3> run_impact(int nprocs) {
-  const std::string dir = make_run_dir("impact" + std::to_string(nprocs));
+const char *kImpactFix =
+    "fix bonds all bond/breakable modulus 1e10 stiffness_ratio 2.5 tensile_strength 4e6 "
+    "cohesion 4e6 friction_angle 30 gap 0.2 max_bonds 16 dump_bonds bonds.txt\n";
+
+std::array<double, 3> run_impact(int nprocs, const std::string &fix = kImpactFix) {
+  const std::string dir =
+      make_run_dir("impact" + std::to_string(nprocs) + (fix == kImpactFix ? "" : "fj"));
   std::ostringstream d;
   d.precision(17);
   d << "units si\natom_style sphere\natom_modify map array\nboundary f f f\nnewton off\n"
@@ -413,30 +422,34 @@ std::array<double, 3> run_impact(int nprocs) {
     << "velocity all set 0 0 -10 units box\n"
     << "fix wall all wall/gran model hertz tangential history primitive type 1 zplane 0.0\n"
     << "fix integr all nve/sphere\n"
-    << "fix bonds all bond/breakable modulus 1e10 stiffness_ratio 2.5 tensile_strength 4e6 "
-       "cohesion 4e6 friction_angle 30 gap 0.2 max_bonds 16 dump_bonds bonds.txt\n"
-    << "timestep 5e-8\n"
+    << fix << "timestep 5e-8\n"
     << "variable n0 equal f_bonds[1]\nvariable na equal atoms\n"
     << "thermo_style custom step atoms f_bonds[1] f_bonds[2] f_bonds[3] f_bonds[4]\n"
     << "thermo 500\nrun 0\n"
     << "print \"START ${n0} ${na}\" file start.txt\n"
     << "run 6000\n"
-    << "variable nb equal f_bonds[2]\nprint \"END ${nb}\" file end.txt\n"
+    << "variable nb equal f_bonds[2]\nvariable ni equal f_bonds[1]\n"
+    << "print \"END ${nb} ${ni}\" file end.txt\n"
     << "write_dump all custom atoms_end.dump id f_bonds\n";
   const auto r = run_deck(dir, d.str(), nprocs);
   EXPECT_EQ(r.exit_code, 0) << r.screen;
   std::ifstream s(dir + "/start.txt"), e(dir + "/end.txt");
   std::string w;
-  double n0 = -1, na = -1, nb = -1;
+  double n0 = -1, na = -1, nb = -1, ni = -1;
   s >> w >> n0 >> na;
-  e >> w >> nb;
+  e >> w >> nb >> ni;
   const auto bonds = read_bonds(dir + "/bonds.txt");
   const int frags = count_fragments(static_cast<int>(na), bonds);
   std::printf(
       "impact on %d rank(s): %g atoms, %g bonds, %g broken, %zu intact in dump, %d "
       "fragments\n",
       nprocs, na, n0, nb, bonds.size(), frags);
-  EXPECT_EQ(static_cast<double>(bonds.size()), n0 - nb) << "dump disagrees with counters";
+  EXPECT_EQ(static_cast<double>(bonds.size()), ni) << "dump disagrees with the intact count";
+  // Parallel bonds break whole: broken + intact = created. (A flat joint
+  // counts broken elements.)
+  if (fix == kImpactFix) {
+    EXPECT_EQ(ni, n0 - nb) << "counters disagree";
+  }
   // Per-atom intact-bond counts (f_ID in dump custom) sum to twice the bonds.
   double count_sum = 0.0;
   int lines = 0;
@@ -659,3 +672,64 @@ INSTANTIATE_TEST_SUITE_P(
                 "tensile_strength 2e7 cohesion 2e7\n",
                 "fix bond/breakable: needs the atom map", "atom_modify map array\n"}),
     [](const ::testing::TestParamInfo<BadDeck> &info) { return std::string(info.param.name); });
+
+// fix bond/flatjoint through the same runs: the pair's break loads, restart
+// and the 1- against 2-rank impact (the interface's closed forms are in
+// test_flat_joint.cpp).
+
+// Slow pull of a flat-jointed pair (2 x 4 elements): every element reaches
+// sigma_t together, |F| = sigma_t A at the break (1 %); the counters count
+// elements, the break log one line per step with breaks.
+TEST(FlatJointPair, SlowPullBreaksAtTensileStrength) {
+  const std::string dir = make_run_dir("fj_pull");
+  const auto rows = run_prescribed_pair(
+      dir, 0.2, 0.0, 2000, 1e-8, flat_joint_fix("break_log breaks.txt dump_bonds bonds.txt"));
+  expect_peak_force(rows, kSigmaT * kArea, "flat joint pull");
+  EXPECT_EQ(rows.back()[2], 0.0) << "interface still bonded at the end";
+  EXPECT_EQ(rows.back()[3], 8.0) << "not all 8 elements broke in tension";
+  EXPECT_EQ(rows.back()[4], 0.0);
+  EXPECT_EQ(rows.back()[1], 0.0) << "an open interface must carry nothing";
+  EXPECT_TRUE(read_bonds(dir + "/bonds.txt").empty());
+}
+
+// Slow shear without rotation: uniform shear on every element, which break
+// together at tau = c: |F| = c A (1 %); afterwards the open pair (no
+// compression) carries no friction.
+TEST(FlatJointPair, SlowShearBreaksAtCohesion) {
+  const std::string dir = make_run_dir("fj_shear");
+  const auto rows = run_prescribed_pair(dir, 0.0, 0.5, 2000, 1e-8, flat_joint_fix());
+  expect_peak_force(rows, kCohesion * kArea, "flat joint shear");
+  EXPECT_EQ(rows.back()[2], 0.0);
+  EXPECT_EQ(rows.back()[4], 8.0) << "not all 8 elements broke in shear";
+  EXPECT_LT(rows.back()[1], 1e-6 * kCohesion * kArea);
+}
+
+namespace {
+const std::string kBurstFlatJoint =
+    "fix bonds all bond/flatjoint modulus 2e10 stiffness_ratio 2.5 tensile_strength 5e6 "
+    "cohesion 5e6 friction_angle 30 gap 0.2 max_bonds 16 elements 1 3 dump_bonds bonds.txt\n";
+}  // namespace
+
+// The interfaces' element histories go through restart files (written
+// between runs, and on 2 ranks read on 1). Tolerances as for the parallel bond.
+TEST(FlatJointRestart, RestartedRunMatchesStraightRun) {
+  check_restart(1, 1, 1e-12, false, kBurstFlatJoint);
+}
+TEST(FlatJointRestart, RestartAcrossRankCounts) { check_restart(2, 1, 1e-9, false, kBurstFlatJoint); }
+
+// The bonded ball's impact with flat joints on 1 and 2 ranks: the same bond
+// count; broken elements and fragments within 2 %.
+TEST(FlatJointMpi, ImpactOneVersusTwoRanks) {
+  const std::string fix =
+      "fix bonds all bond/flatjoint modulus 1e10 stiffness_ratio 2.5 tensile_strength 4e6 "
+      "cohesion 4e6 friction_angle 30 gap 0.2 max_bonds 16 elements 1 3 dump_bonds bonds.txt\n";
+  const auto one = run_impact(1, fix);
+  const auto two = run_impact(2, fix);
+  ASSERT_GT(one[0], 0.0);
+  EXPECT_EQ(one[0], two[0]) << "bond counts before impact differ";
+  std::printf("flat joint impact: broken elements %g (1 rank) vs %g (2 ranks); fragments %g vs %g\n",
+              one[1], two[1], one[2], two[2]);
+  EXPECT_GT(one[1], 0.01 * 3 * one[0]) << "impact breaks almost nothing: test would be vacuous";
+  EXPECT_NEAR(two[1] / one[1], 1.0, 0.02);
+  EXPECT_NEAR(two[2] / one[2], 1.0, 0.02);
+}

@@ -1,0 +1,54 @@
+"""UCS, Brazilian tensile strength and their ratio for each model run by
+strength_ratio.sh: UCS = peak of the mean platen force over the cylinder's
+cross-section; T = 2 P / (pi D t) at the peak load P (ISRM Brazilian test);
+E = secant modulus at half the peak (gauge length from ucs_info.txt)."""
+import math
+import sys
+
+
+def info(path):
+    words = open(path).read().split()
+    return {words[i]: words[i + 1] for i in range(len(words) - 1)}
+
+
+def curve(path):
+    rows = []
+    for line in open(path):
+        if line.startswith("#") or not line.strip():
+            continue
+        rows.append([float(v) for v in line.split()])
+    return rows
+
+
+def analyse(out, model):
+    ui = info(f"{out}/{model}/ucs/ucs_info.txt")
+    uc = curve(f"{out}/{model}/ucs/ucs_curve.txt")
+    d = float(ui["diameter"])
+    area = math.pi * d * d / 4
+    gauge = float(ui["gauge_length"])
+    stress = [0.5 * (r[3] + r[4]) / area for r in uc]
+    strain = [r[2] / gauge for r in uc]
+    k = max(range(len(stress)), key=lambda i: stress[i])
+    ucs = stress[k]
+    half = next(i for i in range(len(stress)) if stress[i] >= 0.5 * ucs)
+    young = stress[half] / strain[half]
+    bi = info(f"{out}/{model}/brazilian/brazilian_info.txt")
+    bc = curve(f"{out}/{model}/brazilian/brazilian_curve.txt")
+    load = max(0.5 * (r[3] + r[4]) for r in bc)
+    tensile = 2 * load / (math.pi * float(bi["diameter"]) * float(bi["thickness"]))
+    peaked = k + 1 < len(stress)
+    return ucs, tensile, young, peaked
+
+
+def main():
+    out, models = sys.argv[1], sys.argv[2:]
+    print("| model | UCS [MPa] | tensile [MPa] | UCS/T | E (secant at UCS/2) [GPa] | UCS peaked |")
+    print("|---|---|---|---|---|---|")
+    for m in models:
+        ucs, t, e, peaked = analyse(out, m)
+        print(f"| {m} | {ucs / 1e6:.1f} | {t / 1e6:.2f} | {ucs / t:.2f} | {e / 1e9:.1f} | "
+              f"{'yes' if peaked else 'no (cap reached)'} |")
+
+
+if __name__ == "__main__":
+    main()

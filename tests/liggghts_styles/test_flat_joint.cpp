@@ -1,0 +1,282 @@
+// The flat-joint interface (liggghts_styles/flat_joint.h) against its closed
+// forms: layout, break loads of the elements in tension and in shear, the
+// moment of a partly broken interface, the rolling resistance of a fully
+// broken one, objectivity under rigid rotation, the stiffnesses that set the
+// critical time step, and the energy of a loading path.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "flat_joint.h"
+
+using namespace mill::flat_joint;
+using mill::bond_geometry::cross;
+using mill::bond_geometry::dot;
+using mill::bond_geometry::load3;
+using mill::bond_geometry::Vec3;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kR = 1.0e-3;  // interface radius [m]
+
+Params sandstone() {
+  Params p;
+  p.kn = 2.0e10 / 2.0e-3;  // E_b / L0, Pa/m
+  p.ks = p.kn / 2.5;
+  p.radius = kR;
+  p.tensile = 2.0e7;
+  p.cohesion = 4.0e7;
+  p.tan_phi = std::tan(30.0 * kPi / 180.0);
+  p.mu = 0.5;
+  return p;
+}
+
+const Vec3 kN{0, 0, 1};
+
+// A fresh interface along +z.
+std::vector<double> fresh(const Layout &lay, bool bonded = true) {
+  std::vector<double> h(history_size(lay.elements()));
+  init_history(h.data(), lay, kN, bonded);
+  return h;
+}
+
+// One step with the given increments about/along the interface frame.
+Step step(double stretch, Vec3 du = {0, 0, 0}, Vec3 dtheta = {0, 0, 0}) {
+  Step s;
+  s.n_mid = s.n_end = kN;
+  s.du_shear = du;
+  s.dtheta = dtheta;
+  s.vrel = s.wrel = Vec3{0, 0, 0};
+  s.dt = 1e-7;
+  s.stretch = stretch;
+  return s;
+}
+
+Step evaluate_only(double stretch) {
+  Step s = step(stretch);
+  s.advance = false;
+  return s;
+}
+
+Vec3 t1_of(const std::vector<double> &h) { return load3(h.data() + kT1); }
+Vec3 t2_of(const std::vector<double> &h) { return cross(kN, t1_of(h)); }
+
+void set_state(std::vector<double> &h, int e, double state) { h[kHistory + 3 * e + kState] = state; }
+
+}  // namespace
+
+// Areas sum to the disc; the intact interface has the disc's A, I and J
+// (radius of gyration per ring), so kn A, ks A, kn I, ks J: the parallel
+// bond's stiffnesses and critical time step. Exact to round-off.
+TEST(FlatJoint, IntactInterfaceHasTheDiscsStiffness) {
+  const Params p = sandstone();
+  const double area = kPi * kR * kR, inertia = kPi * std::pow(kR, 4) / 4.0;
+  for (auto [nr, na] : {std::pair{1, 3}, {1, 4}, {2, 3}, {2, 6}, {3, 8}}) {
+    const Layout lay = make_layout(nr, na);
+    double sum = 0;
+    for (double a : lay.area) sum += a;
+    EXPECT_NEAR(sum, 1.0, 1e-14) << nr << "x" << na;
+    const Stiffness k = intact_stiffness(lay, p);
+    EXPECT_NEAR(k.normal / (p.kn * area), 1.0, 1e-12);
+    EXPECT_NEAR(k.shear / (p.ks * area), 1.0, 1e-12);
+    EXPECT_NEAR(k.bending / (p.kn * inertia), 1.0, 1e-12) << nr << "x" << na;
+    EXPECT_NEAR(k.twisting / (p.ks * 2.0 * inertia), 1.0, 1e-12) << nr << "x" << na;
+  }
+  EXPECT_THROW(make_layout(1, 2), std::invalid_argument);
+  EXPECT_THROW(make_layout(0, 3), std::invalid_argument);
+  EXPECT_THROW(make_layout(5, 8), std::invalid_argument);
+}
+
+// Uniform tension: every element reaches sigma_c together, at the stretch
+// sigma_c / kn, carrying sigma_c A (0.1 % either side of the closed form).
+TEST(FlatJoint, TensionBreakLoadIsStrengthTimesArea) {
+  const Params p = sandstone();
+  const Layout lay = make_layout(2, 4);
+  const double s_break = p.tensile / p.kn;
+  auto h = fresh(lay);
+  Result r = update(h.data(), lay, p, step(0.999 * s_break));
+  EXPECT_EQ(r.broke_tension, 0);
+  EXPECT_NEAR(-dot(r.force_b, kN) / (p.tensile * kPi * kR * kR), 0.999, 1e-9);
+  EXPECT_NEAR(r.sigma_max / p.tensile, 0.999, 1e-9);
+  r = update(h.data(), lay, p, step(1.001 * s_break));
+  EXPECT_EQ(r.broke_tension, lay.elements());
+  EXPECT_EQ(r.bonded, 0);
+  EXPECT_NEAR(dot(r.force_b, r.force_b), 0.0, 1e-30);  // open: carries nothing
+  // The energy it held, (sigma_c A)^2 / (2 kn A) at the break, is released.
+  const double held = 0.5 * p.kn * kPi * kR * kR * std::pow(1.001 * s_break, 2);
+  EXPECT_NEAR(r.released / held, 1.0, 1e-9);
+}
+
+// Bending: the element farthest from the axis breaks first, alone, at
+// theta = sigma_c / (kn y_max) (one element of three at y = rho sin 60).
+TEST(FlatJoint, BendingBreaksTheOuterElementFirst) {
+  const Params p = sandstone();
+  const Layout lay = make_layout(1, 3);
+  auto h = fresh(lay);
+  const Vec3 t1 = t1_of(h);
+  double ymax = 0;
+  for (int e = 0; e < 3; ++e) ymax = std::max(ymax, kR * lay.py[e]);
+  EXPECT_NEAR(ymax, kR * std::sqrt(0.5) * std::sin(kPi / 3.0), 1e-15);
+  const double theta = p.tensile / (p.kn * ymax);
+  Result r = update(h.data(), lay, p, step(0.0, {0, 0, 0}, (0.999 * theta) * t1));
+  EXPECT_EQ(r.broke_tension, 0);
+  r = update(h.data(), lay, p, step(0.0, {0, 0, 0}, (0.002 * theta) * t1));
+  EXPECT_EQ(r.broke_tension, 1);
+  EXPECT_EQ(r.bonded, 2);
+}
+
+// Shear: uniform shear breaks every element at tau = c - sigma tan(phi_b);
+// under compression sigma < 0 the strength rises by |sigma| tan(phi_b).
+// After the break the shear force drops to the Coulomb cap mu |N|.
+TEST(FlatJoint, ShearBreakLoadFollowsMohrCoulomb) {
+  const Params p = sandstone();
+  const Layout lay = make_layout(1, 4);
+  const double area = kPi * kR * kR;
+  for (double sigma : {0.0, -3.0e7}) {
+    const double stretch = sigma / p.kn;
+    const double strength = p.cohesion - sigma * p.tan_phi;
+    const double du = strength / p.ks;  // tau = ks du
+    auto h = fresh(lay);
+    const Vec3 t1 = t1_of(h);
+    Result r = update(h.data(), lay, p, step(stretch, (0.999 * du) * t1));
+    EXPECT_EQ(r.broke_shear, 0) << sigma;
+    EXPECT_NEAR(dot(r.force_b, t1) / (-0.999 * strength * area), 1.0, 1e-9) << sigma;
+    EXPECT_NEAR(r.tau_ratio, 0.999, 1e-9);
+    r = update(h.data(), lay, p, step(stretch, (0.002 * du) * t1));
+    EXPECT_EQ(r.broke_shear, lay.elements()) << sigma;
+    const double cap = p.mu * (-sigma) * area;  // mu |N|, zero without compression
+    EXPECT_NEAR(std::fabs(dot(r.force_b, t1)), cap, 1e-9 * strength * area) << sigma;
+  }
+}
+
+// A partly broken interface (1 x 4, the two elements at y > 0 broken) bent
+// about t1: opening the broken side it carries the bonded half only,
+// M = -kn theta I / 2 with the compressive force kn theta A R / 4; closing
+// the broken side every element carries, M = -kn theta I (the broken ones
+// pressed). Closed forms of the layout: points (+-R/2, +-R/2), A/4 each.
+TEST(FlatJoint, PartlyBrokenInterfaceCarriesItsClosedFormMoment) {
+  const Params p = sandstone();
+  const Layout lay = make_layout(1, 4);
+  const double area = kPi * kR * kR, inertia = kPi * std::pow(kR, 4) / 4.0;
+  const double theta = 1.0e-4;
+  for (double sign : {1.0, -1.0}) {
+    auto h = fresh(lay);
+    for (int e = 0; e < 4; ++e)
+      if (lay.py[e] > 0) set_state(h, e, 1.0);
+    const Vec3 t1 = t1_of(h);
+    const Result r = update(h.data(), lay, p, step(0.0, {0, 0, 0}, (sign * theta) * t1));
+    const double m = dot(r.moment_b, t1);
+    if (sign > 0) {
+      EXPECT_NEAR(m / (-p.kn * theta * inertia / 2.0), 1.0, 1e-12);
+      EXPECT_NEAR(dot(r.force_b, kN) / (p.kn * theta * area * kR / 4.0), 1.0, 1e-12);
+    } else {
+      EXPECT_NEAR(m / (p.kn * theta * inertia), 1.0, 1e-12);
+      EXPECT_NEAR(dot(r.force_b, kN), 0.0, 1e-12 * p.kn * theta * area * kR);
+    }
+    EXPECT_EQ(r.bonded, 2);
+  }
+}
+
+// A fully broken interface pressed by P = kn A |s| resists rolling: elastic
+// (M = kn I theta) until the first elements lift off at theta = |s| / y_max,
+// where M = P y_max = P R/2 (1 x 4); beyond, only the pressed side carries,
+// M = kn (A/2) (|s| + theta R/2) R/2. The parallel bond's contact stops at
+// P R/4 (fix bond/breakable, contact_moment yes).
+TEST(FlatJoint, FullyBrokenInterfaceResistsRolling) {
+  const Params p = sandstone();
+  const Layout lay = make_layout(1, 4);
+  const double area = kPi * kR * kR, inertia = kPi * std::pow(kR, 4) / 4.0;
+  const double s = -1.0e-7, P = p.kn * area * (-s);
+  const double lift = (-s) / (kR / 2.0);
+  auto h = fresh(lay, false);
+  const Vec3 t1 = t1_of(h);
+  // theta about t1 opens y > 0: the moment on b is along -t1.
+  Result r = update(h.data(), lay, p, step(s, {0, 0, 0}, (0.5 * lift) * t1));
+  EXPECT_NEAR(-dot(r.moment_b, t1) / (p.kn * inertia * 0.5 * lift), 1.0, 1e-12);
+  r = update(h.data(), lay, p, step(s, {0, 0, 0}, (0.5 * lift) * t1));
+  EXPECT_NEAR(-dot(r.moment_b, t1) / (P * kR / 2.0), 1.0, 1e-9);
+  r = update(h.data(), lay, p, step(s, {0, 0, 0}, lift * t1));  // theta = 2 lift
+  const double m2 = p.kn * (area / 2.0) * ((-s) + 2.0 * lift * kR / 2.0) * kR / 2.0;
+  EXPECT_NEAR(-dot(r.moment_b, t1) / m2, 1.0, 1e-9);
+  EXPECT_EQ(r.bonded, 0);
+}
+
+// A loaded interface turned rigidly with its pair (about an in-plane axis,
+// 90 degrees in 2000 steps, with a spin about n): the force and moment turn
+// with it, their components in the pair's frame unchanged to 1e-6.
+TEST(FlatJoint, RigidRotationChangesNothingInThePairsFrame) {
+  const Params p = sandstone();
+  const Layout lay = make_layout(2, 4);
+  auto h = fresh(lay);
+  const Vec3 t1 = t1_of(h), t2 = t2_of(h);
+  const Result r0 =
+      update(h.data(), lay, p, step(2e-7, 2e-7 * t1 + 1e-7 * t2, 1e-5 * t1 - 2e-5 * t2 + 3e-5 * kN));
+  const Vec3 f0{dot(r0.force_b, t1), dot(r0.force_b, t2), dot(r0.force_b, kN)};
+  const Vec3 m0{dot(r0.moment_b, t1), dot(r0.moment_b, t2), dot(r0.moment_b, kN)};
+  // Rotation about t2 by phi (n turns towards t1), and the frame spins about n.
+  const int steps = 2000;
+  const double dphi = 0.5 * kPi / steps, spin = 1e-3;
+  auto turn = [&](Vec3 v, double phi) {
+    return std::cos(phi) * v + std::sin(phi) * cross(t2, v) + (1 - std::cos(phi)) * dot(t2, v) * t2;
+  };
+  Result r = r0;
+  for (int k = 1; k <= steps; ++k) {
+    Step s = step(2e-7);
+    s.n_mid = turn(kN, (k - 0.5) * dphi);
+    s.n_end = turn(kN, k * dphi);
+    // The relative rotation is zero; both grains turn by dphi about t2 and
+    // spin about n: the frame's spin is the mean spin about n.
+    s.spin = spin;
+    r = update(h.data(), lay, p, s);
+  }
+  // The pair's frame at the end: n' = turn(n), and the material frame turned
+  // further by the accumulated spin about n'.
+  const Vec3 n1 = turn(kN, 0.5 * kPi);
+  const double total_spin = steps * spin;
+  const Vec3 a1 = turn(t1, 0.5 * kPi), a2 = turn(t2, 0.5 * kPi);
+  const Vec3 e1 = std::cos(total_spin) * a1 + std::sin(total_spin) * a2;
+  const Vec3 e2 = cross(n1, e1);
+  const Vec3 f1{dot(r.force_b, e1), dot(r.force_b, e2), dot(r.force_b, n1)};
+  const Vec3 m1{dot(r.moment_b, e1), dot(r.moment_b, e2), dot(r.moment_b, n1)};
+  const double fs = std::sqrt(dot(f0, f0)), ms = std::sqrt(dot(m0, m0));
+  EXPECT_LT(std::sqrt(dot(f1 - f0, f1 - f0)) / fs, 1e-6);
+  EXPECT_LT(std::sqrt(dot(m1 - m0, m1 - m0)) / ms, 1e-6);
+  EXPECT_NEAR(r.energy / r0.energy, 1.0, 1e-6);
+}
+
+// A loading path in many small steps (stretch, shear, bend and twist
+// together, below every strength): the work the interface's force and moment
+// take equals the energy it stores (trapezoid rule, 1e-6), and unloading
+// along the same path returns it all.
+TEST(FlatJoint, WorkOfALoadingPathIsTheStoredEnergy) {
+  const Params p = sandstone();
+  const Layout lay = make_layout(2, 6);
+  auto h = fresh(lay);
+  const Vec3 t1 = t1_of(h), t2 = t2_of(h);
+  const int steps = 4000;
+  const Vec3 du = (1e-7 / steps) * (t1 + 0.5 * t2);
+  const Vec3 dth = (2e-5 / steps) * (t1 - t2) + (3e-5 / steps) * kN;
+  const double ds = 1e-7 / steps;
+  Result prev = update(h.data(), lay, p, evaluate_only(0.0));
+  double work = 0, loaded = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    const double sign = pass == 0 ? 1.0 : -1.0;
+    for (int k = 1; k <= steps; ++k) {
+      const double stretch = pass == 0 ? k * ds : (steps - k) * ds;
+      const Result r = update(h.data(), lay, p, step(stretch, sign * du, sign * dth));
+      EXPECT_EQ(r.bonded, lay.elements());
+      // Work done on the interface by the grains: -(force on b) . (b's motion).
+      const Vec3 fm = 0.5 * (prev.force_b + r.force_b), mm = 0.5 * (prev.moment_b + r.moment_b);
+      work -= dot(fm, sign * du + (sign * ds) * kN) + dot(mm, sign * dth);
+      prev = r;
+    }
+    if (pass == 0) {
+      loaded = prev.energy;
+      EXPECT_NEAR(work / loaded, 1.0, 1e-6);
+    }
+  }
+  EXPECT_LT(prev.energy, 1e-12 * loaded);
+  EXPECT_LT(std::fabs(work), 1e-6 * loaded);
+}
