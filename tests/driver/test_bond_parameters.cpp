@@ -26,8 +26,19 @@ std::string slurp(const fs::path& f) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-// modulus, kn/ks, tensile, cohesion, friction angle, moment factor, radius multiplier.
-BondParams sample() { return {18.69e9, 2.5, 1.0e7, 2.0e7, 30, 0.5, 0.8, "test"}; }
+// One set of parameters, by name (a new member keeps its default).
+BondParams sample() {
+  BondParams b;
+  b.modulus = 18.69e9;
+  b.stiffness_ratio = 2.5;
+  b.tensile = 1.0e7;
+  b.cohesion = 2.0e7;
+  b.friction_angle_deg = 30;
+  b.moment_factor = 0.5;
+  b.radius_multiplier = 0.8;
+  b.origin = "test";
+  return b;
+}
 
 }  // namespace
 
