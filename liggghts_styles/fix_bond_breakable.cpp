@@ -827,6 +827,7 @@ void FixBondBreakable::evaluate_flat_joint(const AtomArrays &at, ListedBond &bon
   st.vrel = h.vt + h.vn * h.n;
   st.dt = at.dt;
   st.stretch = len - bond.l0;
+  st.gap0 = bond.gap0;
   st.advance = advance;
   mill::flat_joint::Params p;
   p.kn = bond.kna * bond.inv_area;
@@ -962,6 +963,7 @@ void FixBondBreakable::build_bond_list() {
       lb.cs = lb.cn * std::sqrt(inv_ratio_);
       lb.drop_len = slot[L0] + gap_ * std::min(radius[lb.a], radius[lb.b]);
       lb.fj = flat_joint_ ? &bonds_[i][k * ncol_ + NCOL] : nullptr;
+      lb.gap0 = std::max(0.0, slot[L0] - radius[lb.a] - radius[lb.b]);
       list_.push_back(lb);
     }
   }

@@ -169,6 +169,7 @@ class FixBondBreakable : public Fix {
     double kni, ksj;                      // kn I, ks J [N m]
     double cn, cs;                        // dashpots (damping > 0) [N s/m]
     double drop_len;                      // a contact is dropped beyond this length [m]
+    double gap0;                          // flat joint: installation gap, >= 0 [m]
     double *fj;  // bond/flatjoint: the interface's history, in i's slot (mirrored by store_history)
   };
   std::vector<ListedBond> list_;

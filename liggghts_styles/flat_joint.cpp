@@ -162,13 +162,16 @@ Result update(double *h, const Layout &lay, const Params &p, const Step &s) {
       }
     }
     if (el[kState] != 0.0) {
-      // Broken: compression only, shear up to mu x the compression.
-      if (u >= 0.0) {
+      // Broken: compression only, once the faces touch (u + g0 < 0), and
+      // shear up to mu x the compression.
+      const double uc = u + s.gap0;
+      if (uc >= 0.0) {
         // Open: the cap mu |N| has gone to zero and the shear slips off
         // (friction; one that broke this step counts it as released).
         if (s.advance && !broke) out.slipped += slip_loss(load, ElementLoad{}, prev1[e], prev2[e], ksa);
         load = ElementLoad{};
       } else {
+        load.normal = kna * uc;
         const double cap = p.mu * (-load.normal);
         const double mag = std::sqrt(load.s1 * load.s1 + load.s2 * load.s2);
         if (mag > cap) {

@@ -10,7 +10,9 @@
 //     its normal stress exceeds the tensile strength or its shear stress the
 //     Mohr-Coulomb strength c - sigma tan(phi_b);
 //   - a broken element carries compression only, and shear up to
-//     mu x its compressive force (Coulomb slip).
+//     mu x its compressive force (Coulomb slip), once the grains' faces
+//     touch: an interface made across an installation gap g0 (grains that
+//     did not touch) closes that gap before its broken elements push back.
 // Because every element sits at its own place on the disc, a partly broken
 // interface still carries a moment from its bonded elements, and a fully
 // broken one under compression resists rolling until its load has moved to
@@ -90,6 +92,9 @@ struct Step {
   Vec3 wrel;          // spin of b relative to a (half step) [rad/s]
   double dt = 0;      // [s]
   double stretch = 0; // centre distance minus its bonded length, at the end [m]
+  double gap0 = 0;    // installation gap: the grains' surface gap when the interface
+                      // was made, >= 0 [m]; a broken element touches once the
+                      // opening stretch + gap0 is below zero
   bool advance = true;  // false: evaluate only (no increment, no break)
 };
 

@@ -12,7 +12,10 @@
 # runs/<case>/calibrate/jobs/calibration/specimen). key=value pairs override
 # the parameters below (bond_modulus, stiffness_ratio, bond_tensile,
 # bond_cohesion, bond_friction, moment_factor, elements, joint_friction,
-# unbonded_frac, models="parallel flatjoint", ...).
+# unbonded_frac, bond_gap (interfaces out to this surface gap / min radius),
+# fj_extra (more keywords for the flat joint, e.g. fj_extra="joint_friction 0.8"),
+# bond_extra (more keywords for both models, e.g. bond_extra="unbonded_seed 7"),
+# models="parallel flatjoint", ...).
 set -eu
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
@@ -29,7 +32,7 @@ ucs_target=50e6 tensile_target=5e6
 bond_modulus=9.9925879e10 stiffness_ratio=3.9440781 bond_tensile=24943466
 bond_cohesion=49886932 bond_friction=30 moment_factor=0 radius_mult=1.0
 bond_gap=0.15 max_bonds=16 rate=2 elements="1 3" joint_friction=-1 unbonded_frac=0
-models="parallel flatjoint"
+fj_extra="" bond_extra="" models="parallel flatjoint"
 ucs_r=0.0131578 disc_r=0.0209757
 for kv in "$@"; do
   key=${kv%%=*}
@@ -43,9 +46,9 @@ out="$(cd "$out" && pwd)"
 
 # The deck with its fix bond/breakable block swapped for the model's line.
 make_deck() {  # deck model -> file
-  /usr/bin/python3 - "$root/liggghts_inputs/$1.in.tmpl" "$2" "$elements" "$joint_friction" <<'PY'
+  /usr/bin/python3 - "$root/liggghts_inputs/$1.in.tmpl" "$2" "$elements" "$joint_friction" "$fj_extra" "$bond_extra" <<'PY'
 import re, sys
-deck, model, elements, mu = sys.argv[1:5]
+deck, model, elements, mu, extra, both = sys.argv[1:7]
 text = open(deck).read()
 block = re.search(r"^fix bonds all bond/breakable .*?(?<!&)\n", text, re.S | re.M)
 if model == "flatjoint":
@@ -53,9 +56,14 @@ if model == "flatjoint":
             "    tensile_strength ${bond_tensile} cohesion ${bond_cohesion} friction_angle ${bond_friction} &\n"
             "    radius_multiplier ${radius_mult} elements " + elements +
             ("" if float(mu) < 0 else " joint_friction " + mu) +
+            (" " + extra if extra else "") +
             " unbonded_fraction ${unbonded_frac} gap ${bond_gap} max_bonds ${max_bonds}"
             " damping ${bond_damping}\n")
-    text = text[:block.start()] + line + text[block.end():]
+else:
+    line = block.group(0)
+if both:
+    line = line.rstrip("\n") + " " + both + "\n"
+text = text[:block.start()] + line + text[block.end():]
 sys.stdout.write(text)
 PY
 }

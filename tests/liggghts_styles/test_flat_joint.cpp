@@ -203,6 +203,36 @@ TEST(FlatJoint, FullyBrokenInterfaceResistsRolling) {
   EXPECT_EQ(r.bonded, 0);
 }
 
+// An unbonded interface made across an installation gap g0: its elements
+// carry nothing until the faces touch (stretch = -g0), then kn A (stretch +
+// g0) in compression, shear capped at mu times that; a bonded one is loaded
+// from its bonded length as if there were no gap. Exact to round-off.
+TEST(FlatJoint, GappedInterfacePushesOnlyOnceItsFacesTouch) {
+  const Params p = sandstone();
+  const Layout lay = make_layout(1, 3);
+  const double area = kPi * kR * kR, g0 = 2.0e-7;
+  auto h = fresh(lay, false);
+  Step s = step(-0.5 * g0);
+  s.gap0 = g0;
+  Result r = update(h.data(), lay, p, s);
+  EXPECT_EQ(dot(r.force_b, r.force_b), 0.0);
+  EXPECT_FALSE(r.loaded);
+  s = step(-1.5 * g0, {2.0e-6, 0, 0});  // closed by g0/2, and sheared far past slip
+  s.gap0 = g0;
+  r = update(h.data(), lay, p, s);
+  const double push = p.kn * area * 0.5 * g0;
+  EXPECT_NEAR(dot(r.force_b, kN) / push, 1.0, 1e-12);
+  const Vec3 shear = r.force_b - dot(r.force_b, kN) * kN;
+  EXPECT_NEAR(std::sqrt(dot(shear, shear)) / (p.mu * push), 1.0, 1e-12);
+  EXPECT_NEAR(r.energy / (0.5 * push * 0.5 * g0 + 0.5 * p.mu * p.mu * push * push / (p.ks * area)),
+              1.0, 1e-12);
+  auto hb = fresh(lay, true);
+  Step sb = step(1.0e-8);
+  sb.gap0 = g0;
+  r = update(hb.data(), lay, p, sb);
+  EXPECT_NEAR(dot(r.force_b, kN) / (-p.kn * area * 1.0e-8), 1.0, 1e-12);
+}
+
 // A loaded interface turned rigidly with its pair (about an in-plane axis,
 // 90 degrees in 2000 steps, with a spin about n): the force and moment turn
 // with it, their components in the pair's frame unchanged to 1e-6.
