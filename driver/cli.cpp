@@ -79,7 +79,15 @@ CLI::Validator decimal(double lo, double hi, bool integer, const std::string& wh
 void check_output_path(const fs::path& out) {
   std::error_code ec;
   for (fs::path p = out; !p.empty(); p = p.parent_path()) {
-    if (fs::exists(p, ec)) {
+    const bool exists = fs::exists(p, ec);
+    if (ec && ec != std::errc::no_such_file_or_directory)
+      throw config::ConfigError(fmt::format("--output {}: {}: {}; expected a run folder (a directory, or a path that "
+                                            "does not exist yet)",
+                                            out.string(), p.string(),
+                                            ec == std::errc::too_many_symbolic_link_levels
+                                                ? "a loop of symbolic links"
+                                                : ec.message()));
+    if (exists) {
       if (fs::is_directory(p, ec)) return;
       throw config::ConfigError(p == out
                                     ? fmt::format("--output {}: is a file; expected a run folder "
@@ -158,7 +166,7 @@ CLI::App* add_impact_command(CLI::App& app, CliArgs& a) {
   impact
       ->add_option("--elements", a.imp_elements,
                    "Elements in the lump; default: the case's lump.n_elements")
-      ->check(decimal(2, 10000000, true, "elements"));
+      ->check(decimal(config::kMinLumpElements, 10000000, true, "elements"));
   impact->add_option("--repeat", a.imp_repeat, "Repeat index (random orientation)")
       ->check(decimal(0, 1000000, true, "repeat"));
   impact->footer(

@@ -120,6 +120,7 @@ void write_provenance(const config::CaseConfig& cfg, const fs::path& run_dir) {
                       {"ore", cfg.ore.to_json()},
                       {"orchestrate_version", MILL_VERSION}};
   j["case_name"] = cfg.name;
+  j["outside_plausible_range"] = config::outliers(cfg);
   jobs::atomic_write(run_dir / "resolved_case.json", j.dump(2) + "\n");
 }
 

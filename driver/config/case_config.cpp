@@ -23,6 +23,8 @@ namespace fs = std::filesystem;
 namespace {
 // A case file or ore card is a page of keys; anything far larger is not one.
 constexpr long long kMaxYamlBytes = 16 << 20;
+// Longest case name: it names the run folder and begins file names in it.
+constexpr size_t kMaxNameLength = 100;
 }  // namespace
 
 size_t edit_distance(const std::string& a, const std::string& b) {
@@ -140,7 +142,35 @@ class Validator {
     bool bad = false;
     if (k.min) bad |= k.min_exclusive ? !(v > *k.min) : !(v >= *k.min);
     if (k.max) bad |= k.max_exclusive ? !(v < *k.max) : !(v <= *k.max);
-    if (bad) fail(line, label, fmt::format("expected {}, got {}", expected_text(k), n.Scalar()));
+    if (bad) {
+      const std::string hint = slip_hint(k, v);
+      fail(line, label,
+           fmt::format("expected {}, got {}{}", expected_text(k), n.Scalar(), hint.empty() ? "" : "; did you mean " + hint + "?"));
+    }
+  }
+
+  // Names of keys of this file that have a plausible range (allow_outside_range).
+  void check_key_list(const KeyDef& k, const YAML::Node& n, int line) {
+    if (!n.IsSequence() || n.size() == 0)
+      fail(line, k.path, fmt::format("expected {} (e.g. [{}]), got {}", expected_text(k), first_plausible(), scalar_text(n)));
+    for (size_t i = 0; i < n.size(); ++i) {
+      const std::string label = fmt::format("{}[{}]", k.path, i);
+      const int l = line < 0 ? line : (line_of(n[i]) ? line_of(n[i]) : line);
+      if (!n[i].IsScalar()) fail(l, label, fmt::format("expected a key name, got {}", scalar_text(n[i])));
+      const KeyDef* named = s_.find(n[i].Scalar());
+      if (!named || !named->plausible) {
+        const std::string hint = suggest(s_, n[i].Scalar());
+        fail(l, label,
+             fmt::format("{} is not a key of the {} with a plausible range{}", shown(n[i].Scalar()), s_.what,
+                         hint.empty() ? " (docs/config.md, \"Plausible ranges\")" : "; did you mean '" + hint + "'?"));
+      }
+    }
+  }
+
+  std::string first_plausible() const {
+    for (const auto& k : s_.keys)
+      if (k.plausible) return k.path;
+    return "";
   }
 
   void check_value(const KeyDef& k, const YAML::Node& n, int line) {
@@ -166,6 +196,7 @@ class Validator {
         if (!n.IsScalar() || std::find(k.choices.begin(), k.choices.end(), n.Scalar()) == k.choices.end())
           fail(line, k.path, fmt::format("expected {}, got {}", expected_text(k), scalar_text(n)));
         break;
+      case KeyType::KeyList: check_key_list(k, n, line); break;
       case KeyType::RealList:
       case KeyType::IntList: {
         const bool integer = k.type == KeyType::IntList;
@@ -192,19 +223,76 @@ class Validator {
 
 }  // namespace
 
+namespace {
+
+// A carriage return without a line feed ends no line for yaml-cpp: in a file
+// with CR-only line endings the first comment swallows the whole file.
+void check_line_endings(const std::string& text, const std::string& file_label) {
+  int line = 1;
+  for (size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '\n') ++line;
+    if (text[i] != '\r' || (i + 1 < text.size() && text[i + 1] == '\n')) continue;
+    if (text.find('\n') == std::string::npos)
+      throw ConfigError(fmt::format("{}: line endings are CR only (an old Mac text file), so YAML reads the file as one "
+                                    "line; expected LF or CRLF line endings: convert with tr '\\r' '\\n' < {} > fixed.yaml",
+                                    file_label, file_label));
+    throw ConfigError(fmt::format("{}:{}: the line ends with a carriage return (CR) alone, so YAML joins it to the next; "
+                                  "expected LF or CRLF line endings: convert with tr '\\r' '\\n' < {} > fixed.yaml",
+                                  file_label, line, file_label));
+  }
+}
+
+// Line of the '---' that starts the second YAML document (0 if not found).
+int second_document_line(const std::string& text) {
+  std::istringstream in(text);
+  std::string l;
+  int n = 0;
+  bool content = false;
+  while (std::getline(in, l)) {
+    ++n;
+    const bool marker = l.rfind("---", 0) == 0 && (l.size() == 3 || std::isspace(static_cast<unsigned char>(l[3])));
+    if (marker && content) return n;
+    const size_t first = l.find_first_not_of(" \t");
+    if (marker || (first != std::string::npos && l[first] != '#')) content = true;
+  }
+  return 0;
+}
+
+// The one YAML document of a file: a ConfigError for bad YAML, several
+// documents, or a file that holds nothing.
+YAML::Node load_one_document(const std::string& text, const std::string& file_label, const Schema& schema) {
+  check_line_endings(text, file_label);
+  std::vector<YAML::Node> docs;
+  try {
+    docs = YAML::LoadAll(text);
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(fmt::format("{}:{}: not valid YAML: {}", file_label, e.mark.line + 1, e.msg));
+  }
+  if (docs.size() > 1)
+    throw ConfigError(fmt::format("{}:{}: a second YAML document starts here ('---'; {} documents in all); expected one "
+                                  "{}: merge them or keep one",
+                                  file_label, second_document_line(text), docs.size(), schema.what));
+  if (docs.empty() || docs[0].IsNull()) {
+    std::string required;
+    for (const auto& k : schema.keys)
+      if (k.default_yaml.empty() && !k.optional) required += (required.empty() ? "" : ", ") + k.path;
+    throw ConfigError(fmt::format("{}: holds no keys (empty, or only comments); expected {} {} with at least: {}",
+                                  file_label, std::string("aeiou").find(schema.what[0]) == std::string::npos ? "a" : "an",
+                                  schema.what, required));
+  }
+  if (!docs[0].IsMap())
+    throw ConfigError(fmt::format("{}:1: expected a YAML mapping of keys at the top level", file_label));
+  return docs[0];
+}
+
+}  // namespace
+
 Document Document::parse(const std::string& text, const std::string& file_label, const Schema& schema,
                          const std::vector<std::pair<std::string, std::string>>& overrides) {
   Document d;
   d.file_ = file_label;
   d.schema_ = &schema;
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(fmt::format("{}:{}: not valid YAML: {}", file_label, e.mark.line + 1, e.msg));
-  }
-  if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
-  if (!root.IsMap()) throw ConfigError(fmt::format("{}:1: expected a YAML mapping of keys at the top level", file_label));
+  YAML::Node root = load_one_document(text, file_label, schema);
   for (const auto& [path, value] : overrides) {
     // Walk/create the sections of the dotted path, then set the leaf.
     std::vector<YAML::Node> chain{root};
@@ -230,15 +318,48 @@ Document Document::parse(const std::string& text, const std::string& file_label,
                                     expected_text(k), k.doc));
     }
   }
+  d.check_plausible();
   return d;
+}
+
+// Every value against its key's plausible range: outside it is an error that
+// names the likely unit slip, unless the file lists the key in
+// allow_outside_range; such an outlier is kept in outliers().
+void Document::check_plausible() {
+  std::set<std::string> allowed;
+  if (values_.count(kAllowOutsideRange))
+    for (const auto& n : values_.at(kAllowOutsideRange)) allowed.insert(n.Scalar());
+  outliers_ = nlohmann::json::array();
+  for (const auto& k : schema_->keys) {
+    if (!k.plausible || !values_.count(k.path)) continue;
+    const Plausible& p = *k.plausible;
+    const std::vector<double> v = reals(k.path);
+    const std::string unit = k.unit.empty() ? "" : " " + k.unit;
+    for (size_t i = 0; i < v.size(); ++i) {
+      if (v[i] >= p.lo && v[i] <= p.hi) continue;
+      if (allowed.count(k.path)) {
+        outliers_.push_back({{"file", file_}, {"key", k.path}, {"value", v[i]}, {"unit", k.unit}, {"plausible", {p.lo, p.hi}}});
+        continue;
+      }
+      const std::string label = where(k.path) + (values_.at(k.path).IsSequence() ? fmt::format("[{}]", i) : "");
+      const std::string hint = slip_hint(k, v[i]);
+      throw ConfigError(fmt::format(
+          "{}: {}{}: {}expected {} in [{}, {}]{} ({}); a deliberate outlier: list {} in {} of this {}", label, num(v[i]),
+          unit, hint.empty() ? "outside the plausible range; " : "did you mean " + hint + "? ", p.what, num(p.lo),
+          num(p.hi), unit, p.source, k.path, kAllowOutsideRange, schema_->what));
+    }
+  }
 }
 
 std::string read_regular_file(const fs::path& file, const std::string& what) {
   // stat first: a directory reads as empty and a FIFO blocks in open().
   struct stat st {};
-  if (::stat(file.c_str(), &st) != 0)
-    throw ConfigError(errno == ENOENT ? fmt::format("{}: {} not found", file.string(), what)
-                                      : fmt::format("{}: cannot open {}: {}", file.string(), what, std::strerror(errno)));
+  if (::stat(file.c_str(), &st) != 0) {
+    if (errno == ENOENT) throw ConfigError(fmt::format("{}: {} not found", file.string(), what));
+    if (errno == ELOOP)
+      throw ConfigError(fmt::format("{}: a loop of symbolic links; expected a {} (a YAML file)", file.string(), what));
+    throw ConfigError(fmt::format("{}: cannot open {}: {}", file.string(), what, std::strerror(errno)));
+  }
   if (S_ISDIR(st.st_mode))
     throw ConfigError(fmt::format("{}: is a directory; expected a {} (a YAML file)", file.string(), what));
   if (!S_ISREG(st.st_mode))
@@ -340,6 +461,10 @@ nlohmann::json Document::to_json() const {
       case KeyType::Bool: j[path] = node.as<bool>(); break;
       case KeyType::RealList:
       case KeyType::IntList: j[path] = reals(path); break;
+      case KeyType::KeyList:
+        j[path] = nlohmann::json::array();
+        for (const auto& n : node) j[path].push_back(n.Scalar());
+        break;
       default: j[path] = node.as<std::string>(); break;
     }
   }
@@ -350,7 +475,7 @@ nlohmann::json ore_keys(const Document& ore) {
   nlohmann::json all = ore.to_json(), out = nlohmann::json::object();
   for (auto it = all.begin(); it != all.end(); ++it)
     if (it.key() != "name" && it.key() != "source" && it.key().rfind("calibrated.", 0) != 0 &&
-        it.key().rfind("jk.", 0) != 0)
+        it.key().rfind("jk.", 0) != 0 && it.key() != kAllowOutsideRange)
       out[it.key()] = it.value();
   return out;
 }
@@ -363,9 +488,6 @@ void check_ore(const Document& ore) {
     if (ore.has(given) && !ore.has(other))
       throw ConfigError(fmt::format("{}: {} is given without {}: a measured JK pair needs both (or remove {})",
                                     ore.where(given), given, other, given));
-  if (ore.real("youngs_modulus") < 1e6)
-    throw ConfigError(fmt::format("{}: expected Young's modulus in Pa (rock: 1e9-1e11), got {:g}; did you give GPa?",
-                                  ore.where("youngs_modulus"), ore.real("youngs_modulus")));
 }
 
 namespace {
@@ -480,6 +602,96 @@ void check_physics(const Document& d) {
                                           after, bdt));
 }
 
+// Plan limits (docs/errors.md, "Plan limits"): a stage of more jobs, a run
+// of more dump files or a field of more grid points than these is refused
+// before any plan is built, as a typo (an extra 0, e-6 for e-3) and not a
+// campaign anyone meant.
+constexpr double kMaxJobs = 1e5;
+constexpr double kMaxDumps = 1000;
+constexpr double kMaxGridPoints = 2e7;
+
+// The breakage stage's job count, from the keys alone (transport conditions:
+// at most velocity_bins per rotor speed); names the key that drives it.
+void check_job_count(const Document& d) {
+  const double rpms = static_cast<double>(d.reals("rotor.rpm").size());
+  const double repeats = static_cast<double>(d.integer("breakage.repeats"));
+  std::vector<std::pair<std::string, double>> factors;
+  double jobs = 0;
+  std::string how;
+  if (d.str("breakage.conditions") == "sweep") {
+    const double nv = static_cast<double>(d.reals("breakage.velocities").size());
+    const double na = static_cast<double>(d.reals("breakage.angles").size());
+    jobs = nv * na * repeats;
+    how = fmt::format("breakage.velocities ({}) x breakage.angles ({}) x breakage.repeats ({})", nv, na, repeats);
+    factors = {{"breakage.velocities", nv}, {"breakage.angles", na}, {"breakage.repeats", repeats}};
+  } else {
+    const double bins = static_cast<double>(d.integer("breakage.velocity_bins"));
+    const double lumps = static_cast<double>(d.integer("breakage.in_mill.lumps"));
+    jobs = rpms * (bins * repeats + lumps);
+    how = fmt::format("rotor.rpm ({}) x (breakage.velocity_bins ({}) x breakage.repeats ({}) + breakage.in_mill.lumps ({}))",
+                      rpms, bins, repeats, lumps);
+    factors = {{"breakage.velocity_bins", bins}, {"breakage.repeats", repeats}, {"breakage.in_mill.lumps", lumps},
+               {"rotor.rpm", rpms}};
+  }
+  if (jobs <= kMaxJobs) return;
+  const auto largest = std::max_element(factors.begin(), factors.end(),
+                                        [](const auto& a, const auto& b) { return a.second < b.second; });
+  throw ConfigError(fmt::format("{}: the breakage stage would have {} jobs ({}); expected at most {} jobs in a stage "
+                                "(docs/errors.md, \"Plan limits\"): lower {}",
+                                d.where(largest->first), num(jobs), how, num(kMaxJobs), largest->first));
+}
+
+// Output intervals: at least one time step, and at most kMaxDumps files per run.
+void check_intervals(const Document& d) {
+  auto fail = [&](const std::string& key, const std::string& msg) {
+    throw ConfigError(fmt::format("{}: {}", d.where(key), msg));
+  };
+  const double dt = d.real("injection.timestep"), t_limit = d.real("injection.time_limit");
+  for (const char* key : {"transport.trajectory_interval", "transport.vtk_interval"}) {
+    const double every = d.real(key);
+    if (every > 0 && every < dt)
+      fail(key, fmt::format("{} s is below one time step (injection.timestep {} s): a record every step; expected 0 (none) "
+                            "or at least {} s",
+                            num(every), num(dt), num(dt)));
+  }
+  const double vtk = d.real("transport.vtk_interval");
+  if (vtk > 0 && t_limit / vtk > kMaxDumps)
+    fail("transport.vtk_interval",
+         fmt::format("{} s over injection.time_limit {} s is {} VTK dumps; expected at most {} (an interval of at least {} s, "
+                     "or 0 for none)",
+                     num(vtk), num(t_limit), num(t_limit / vtk), num(kMaxDumps), num(t_limit / kMaxDumps)));
+  const double dump = d.real("breakage.dump_interval"), bdt = d.real("breakage.timestep");
+  const double run = std::max(d.real("breakage.duration_after_contact"),
+                              d.integer("breakage.in_mill.lumps") > 0 ? d.real("breakage.in_mill.duration") : 0.0);
+  if (dump > 0 && bdt > 0 && dump < bdt)
+    fail("breakage.dump_interval", fmt::format("{} s is below one time step (breakage.timestep {} s): a dump every step; "
+                                               "expected 0 (none) or at least {} s",
+                                               num(dump), num(bdt), num(bdt)));
+  if (dump > 0 && run / dump > kMaxDumps)
+    fail("breakage.dump_interval",
+         fmt::format("{} s over a run of {} s is {} VTK dumps per run; expected at most {} (an interval of at least {} s, "
+                     "or 0 for none)",
+                     num(dump), num(run), num(run / dump), num(kMaxDumps), num(run / kMaxDumps)));
+  if (bdt > 0 && run / bdt > kMaxSteps)
+    fail("breakage.timestep", fmt::format("{} s over a run of {} s is {} steps; expected at most {} steps (a step of at "
+                                          "least {} s, or 0: automatic)",
+                                          num(bdt), num(run), num(run / bdt), num(kMaxSteps), num(run / kMaxSteps)));
+}
+
+// Plans and runs of a bounded size: job counts, dump files, grid points.
+void check_plan_bounds(const Document& d) {
+  check_job_count(d);
+  check_intervals(d);
+  const double W = d.real("mill.housing.width"), H = d.real("mill.housing.height"), D = d.real("mill.housing.depth");
+  const double s = d.real("sample.spacing");
+  const double points = (std::floor(W / s) + 1) * (std::floor(H / s) + 1) * (std::floor(D / s) + 1);
+  if (points > kMaxGridPoints)
+    throw ConfigError(fmt::format("{}: {} m over the {} x {} x {} m housing is {} grid points; expected at most {} "
+                                  "(docs/errors.md, \"Plan limits\"): a spacing of at least {} m",
+                                  d.where("sample.spacing"), num(s), num(W), num(H), num(D), num(points),
+                                  num(kMaxGridPoints), num(std::cbrt(W * H * D / kMaxGridPoints) * 1.01)));
+}
+
 // Cross-key checks of a case: the geometry must fit, lists must be ordered.
 void check_case(const Document& d) {
   auto fail = [&](const std::string& key, const std::string& msg) {
@@ -516,6 +728,24 @@ void check_case(const Document& d) {
     fail("injection.lump_diameter", fmt::format("expected smaller than the inlet ({:g} m), got {:g} m",
                                                 d.real("mill.inlet.size"), d.real("injection.lump_diameter")));
   check_physics(d);
+  check_plan_bounds(d);
+}
+
+// The case name becomes the run folder runs/<name> and the start of file
+// names in it: one plain path component, short enough for any file system.
+void check_name(const Document& d) {
+  const std::string name = d.str("name");
+  for (char ch : name)
+    if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.'))
+      throw ConfigError(fmt::format("{}: expected letters, digits, '-', '_' or '.', got {}", d.where("name"), shown(name)));
+  if (!std::isalnum(static_cast<unsigned char>(name[0])))
+    throw ConfigError(fmt::format("{}: expected a name that starts with a letter or digit (it names the run folder "
+                                  "runs/<name>), got '{}'",
+                                  d.where("name"), name));
+  if (name.size() > kMaxNameLength)
+    throw ConfigError(fmt::format("{}: a name of {} characters; expected at most {} (it names the run folder runs/<name>, "
+                                  "and a file name may have at most 255): '{}...'",
+                                  d.where("name"), name.size(), kMaxNameLength, name.substr(0, 20)));
 }
 
 // Ore card path: absolute; else relative to the case file; else to the project.
@@ -530,10 +760,13 @@ fs::path resolve_ore(const Document& d, const fs::path& case_file, const fs::pat
     tried.push_back(project_dir / "liggghts_inputs" / "materials" / p);
     tried.push_back(project_dir / "liggghts_inputs" / "materials" / (p.string() + ".yaml"));
   }
+  std::error_code ec;
   for (const auto& t : tried)
-    if (fs::is_regular_file(t)) return fs::weakly_canonical(t);
+    if (fs::is_regular_file(t, ec)) return fs::weakly_canonical(t);
   for (const auto& t : tried) {
-    std::error_code ec;
+    if (!fs::exists(t, ec) && ec == std::errc::too_many_symbolic_link_levels)
+      throw ConfigError(fmt::format("{}: ore card '{}' is a loop of symbolic links; expected an ore card (a YAML file)",
+                                    d.where("ore.card"), t.string()));
     if (fs::exists(t, ec))
       throw ConfigError(fmt::format("{}: ore card '{}' is {}; expected an ore card (a YAML file)", d.where("ore.card"),
                                     t.string(), fs::is_directory(t, ec) ? "a directory" : "not a regular file"));
@@ -551,24 +784,22 @@ fs::path resolve_ore(const Document& d, const fs::path& case_file, const fs::pat
 
 }  // namespace
 
+nlohmann::json outliers(const CaseConfig& c) {
+  nlohmann::json all = c.doc.outliers();
+  for (const auto& o : c.ore.outliers()) all.push_back(o);
+  return all;
+}
+
 CaseConfig load_case(const fs::path& file, const fs::path& project_dir,
                      const std::vector<std::pair<std::string, std::string>>& overrides) {
   CaseConfig c;
+  const std::string text = read_regular_file(file, "case file");  // first: names a missing file or a link loop
   c.file = fs::weakly_canonical(file);
   c.project_dir = project_dir;
-  c.doc = Document::parse(read_regular_file(file, "case file"), file.string(), case_schema(), overrides);
+  c.doc = Document::parse(text, file.string(), case_schema(), overrides);
   check_case(c.doc);
-  c.name = c.doc.has("name") ? c.doc.str("name") : file.stem().string();
-  // The name becomes the run folder runs/<name>: one plain path component.
-  const std::string where_name =
-      c.doc.has("name") ? c.doc.where("name") : fmt::format("{}: name (from the file name)", file.string());
-  for (char ch : c.name)
-    if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.'))
-      throw ConfigError(fmt::format("{}: expected letters, digits, '-', '_' or '.', got '{}'", where_name, c.name));
-  if (!std::isalnum(static_cast<unsigned char>(c.name[0])))
-    throw ConfigError(fmt::format("{}: expected a name that starts with a letter or digit (it names the run folder "
-                                  "runs/<name>), got '{}'",
-                                  where_name, c.name));
+  check_name(c.doc);
+  c.name = c.doc.str("name");
   c.ore_file = resolve_ore(c.doc, file, project_dir);
   c.ore = Document::load(c.ore_file, ore_schema());
   check_ore(c.ore);

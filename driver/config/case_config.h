@@ -41,9 +41,14 @@ class Document {
   std::string where(const std::string& path) const;
 
   const std::string& file() const { return file_; }
+  // Values outside their plausible range that the file allows (allow_outside_range):
+  // [{file, key, value, unit, plausible: [lo, hi]}].
+  const nlohmann::json& outliers() const { return outliers_; }
 
  private:
   const KeyDef& def(const std::string& path) const;
+  void check_plausible();
+  nlohmann::json outliers_ = nlohmann::json::array();
   std::string file_;
   const Schema* schema_ = nullptr;
   std::map<std::string, YAML::Node> values_;
@@ -66,13 +71,17 @@ struct CaseConfig {
 CaseConfig load_case(const std::filesystem::path& file, const std::filesystem::path& project_dir,
                      const std::vector<std::pair<std::string, std::string>>& overrides = {});
 
+// The values of the case and its ore card kept outside their plausible range
+// (allow_outside_range), for resolved_case.json and the report.
+nlohmann::json outliers(const CaseConfig& c);
+
 // The text of a case file or ore card (`what` names it in messages): a
 // ConfigError, never a hang, when the path is missing, a directory, a FIFO
 // or another non-regular file, or unreadable.
 std::string read_regular_file(const std::filesystem::path& file, const std::string& what);
 
 // The ore card's macro properties (everything but name, source, calibrated.*
-// and jk.*), as canonical JSON: what job ids hash and a calibration is fitted to.
+// jk.* and allow_outside_range), as canonical JSON: what job ids hash and a calibration is fitted to.
 nlohmann::json ore_keys(const Document& ore);
 
 // Physical consistency of an ore card (UCS > tensile strength, ...).

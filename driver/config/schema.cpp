@@ -57,6 +57,11 @@ KeyDef bond_key(std::string path, const BondParameter& p, std::string def) {
   k.max_exclusive = p.range.max_exclusive;
   return k;
 }
+KeyDef plausible(KeyDef k, double lo, double hi, std::string what, std::string source,
+                 std::vector<UnitSlip> slips = {}) {
+  k.plausible = Plausible{lo, hi, std::move(what), std::move(source), std::move(slips)};
+  return k;
+}
 KeyDef matching(KeyDef k, std::string pattern, std::string text) {
   k.pattern = std::move(pattern);
   k.pattern_text = std::move(text);
@@ -101,40 +106,88 @@ std::vector<KeyDef> stage_resources(const std::string& stage, const std::string&
 
 using T = KeyType;
 
+// Units a value is often typed in instead of the key's SI unit.
+const std::vector<UnitSlip> kPascalSlips = {{"kPa", 1e3}, {"MPa", 1e6}, {"GPa", 1e9}};
+const std::vector<UnitSlip> kMetreSlips = {{"mm", 1e-3}, {"cm", 1e-2}};
+constexpr double kPi = 3.14159265358979323846;
+
+// Where the plausible ranges come from (docs/config.md, "Plausible ranges").
+const char* kMillSource =
+    "a mill as built, from laboratory rotor mills to industrial hammer mills and impact crushers "
+    "(Wills & Finch 2016, Wills' Mineral Processing Technology, 8th ed., the chapter on crushers), with a margin of "
+    "2-10 on each side";
+const char* kRpmSource =
+    "beater and hammer mills run at a few hundred to a few thousand rpm (Wills & Finch 2016, the "
+    "chapter on crushers); the top end is held by the tip-speed bound of 300 m/s (docs/errors.md)";
+const char* kAirSource = "properties of dry air and flue gases, VDI Heat Atlas (2nd ed., 2010)";
+const char* kPlantPressureSource =
+    "U.S. Standard Atmosphere (1976): 54 kPa at 5000 m altitude; a pressurised mill up to 5 bar";
+const char* kPlantTemperatureSource =
+    "plant conditions: cold ambient air (-70 degC) to the hot gas of a drying mill (about 600 degC)";
+const char* kFeedSource = "the feed of impact crushers and hammer mills, a few mm to a few dm (Wills & Finch 2016, the chapter on crushers)";
+
+const char* kRockDensitySource =
+    "Schoen 2011, Physical Properties of Rocks: coal about 1300 kg/m^3, sandstone 2000-2700, basalt about "
+    "3000, ore minerals up to galena's 7500";
+const char* kRockModulusSource =
+    "Goodman 1989, Introduction to Rock Mechanics (2nd ed.), ch. 6: intact rock from chalk and soft shale "
+    "(about 1 GPa) to dense basalt and quartzite (about 100 GPa)";
+const char* kPoissonSource = "Gercek 2007, Poisson's ratio values for rocks, Int. J. Rock Mech. Min. Sci. 44";
+const char* kUcsSource =
+    "Hoek & Brown 1997, Practical estimates of rock mass strength, field estimates of UCS: grade R1 "
+    "(very weak, 1-5 MPa) to R6 (extremely strong, over 250 MPa); the strongest quartzites and basalts "
+    "reach about 400 MPa";
+const char* kTensileSource =
+    "Goodman 1989, Introduction to Rock Mechanics (2nd ed.), ch. 3: rock's tensile strength is 1/25 to "
+    "1/5 of its UCS (1-500 MPa, Hoek & Brown 1997)";
+const char* kRockFrictionSource =
+    "Byerlee 1978, Friction of rocks: 0.6-0.85 rock on rock; lower on steel and on polished surfaces";
+
+// A length of the mill in metres, with its plausible range.
+KeyDef mill_length(KeyDef k, double lo, double hi) {
+  return plausible(std::move(k), lo, hi, "a mill as built", kMillSource, kMetreSlips);
+}
+
 // The case itself, the mill geometry and the rotor speeds.
 std::vector<KeyDef> mill_keys() {
   return {
-      opt(key("name", T::String, "", "", "Case name; default: the case file's name without .yaml")),
+      key("name", T::String, "", "",
+          "Case name, required: names the run folder runs/<name> (letters, digits, -, _, .; at most 100 "
+          "characters)"),
       opt(key("description", T::String, "", "", "Free text shown in the report")),
 
       // --- mill geometry (shared by OpenFOAM and LIGGGHTS through STL) ---
-      positive(key("mill.housing.height", T::Real, "m", "4.0", "Housing height (y, vertical)")),
-      positive(key("mill.housing.width", T::Real, "m", "1.6", "Housing width (x)")),
-      positive(key("mill.housing.depth", T::Real, "m", "0.5",
-                   "Housing depth (z, along the rotor axis)")),
-      positive(key("mill.flywheel.diameter", T::Real, "m", "1.0",
-                   "Flywheel tip diameter (beater plate tips)")),
-      positive(key("mill.flywheel.hub_diameter", T::Real, "m", "0.3",
-                   "Hub (disc) diameter carrying the plates")),
+      mill_length(positive(key("mill.housing.height", T::Real, "m", "4.0", "Housing height (y, vertical)")), 0.2, 20),
+      mill_length(positive(key("mill.housing.width", T::Real, "m", "1.6", "Housing width (x)")), 0.2, 20),
+      mill_length(positive(key("mill.housing.depth", T::Real, "m", "0.5", "Housing depth (z, along the rotor axis)")),
+                  0.05, 10),
+      mill_length(positive(key("mill.flywheel.diameter", T::Real, "m", "1.0", "Flywheel tip diameter (beater plate tips)")),
+                  0.1, 5),
+      mill_length(positive(key("mill.flywheel.hub_diameter", T::Real, "m", "0.3", "Hub (disc) diameter carrying the plates")),
+                  0.02, 5),
       at_least(key("mill.flywheel.n_plates", T::Int, "", "6", "Number of flat beater plates"), 1),
-      positive(key("mill.flywheel.plate_width", T::Real, "m", "0.3",
-                   "Beater plate width along the axis")),
-      positive(
-          key("mill.flywheel.plate_thickness", T::Real, "m", "0.02", "Beater plate thickness")),
-      positive(key("mill.flywheel.axis_height", T::Real, "m", "1.2",
-                   "Height of the rotor axis above the housing floor")),
-      key("mill.flywheel.axis_x", T::Real, "m", "0.0",
-          "Horizontal offset of the rotor axis from the housing centre"),
-      key("mill.inlet.center_x", T::Real, "m", "0.0", "Inlet centre (x) on the housing roof"),
-      positive(key("mill.inlet.size", T::Real, "m", "0.3",
-                   "Inlet opening: side of a square on the roof")),
-      key("mill.outlet.center_x", T::Real, "m", "0.0", "Outlet centre (x) on the housing floor"),
-      positive(key("mill.outlet.size", T::Real, "m", "0.4",
-                   "Outlet opening: side of a square on the floor")),
+      mill_length(positive(key("mill.flywheel.plate_width", T::Real, "m", "0.3", "Beater plate width along the axis")),
+                  0.01, 5),
+      mill_length(positive(key("mill.flywheel.plate_thickness", T::Real, "m", "0.02", "Beater plate thickness")), 0.002,
+                  0.5),
+      mill_length(positive(key("mill.flywheel.axis_height", T::Real, "m", "1.2",
+                               "Height of the rotor axis above the housing floor")),
+                  0.05, 20),
+      mill_length(key("mill.flywheel.axis_x", T::Real, "m", "0.0", "Horizontal offset of the rotor axis from the housing centre"),
+                  -10, 10),
+      mill_length(key("mill.inlet.center_x", T::Real, "m", "0.0", "Inlet centre (x) on the housing roof"), -10, 10),
+      mill_length(positive(key("mill.inlet.size", T::Real, "m", "0.3", "Inlet opening: side of a square on the roof")), 0.01,
+                  10),
+      mill_length(key("mill.outlet.center_x", T::Real, "m", "0.0", "Outlet centre (x) on the housing floor"), -10, 10),
+      mill_length(positive(key("mill.outlet.size", T::Real, "m", "0.4", "Outlet opening: side of a square on the floor")),
+                  0.01, 10),
 
       // --- rotor ---
-      positive(key("rotor.rpm", T::RealList, "rpm", "[2000]",
-                   "Rotor speeds; one flow/transport run per speed"))};
+      plausible(positive(key("rotor.rpm", T::RealList, "rpm", "[2000]", "Rotor speeds; one flow/transport run per speed")),
+                300, 1e5, "a beater mill's rotor speed", kRpmSource, {{"rad/s", 60 / (2 * kPi)}, {"rev/s", 60}}),
+      opt(key(kAllowOutsideRange, T::KeyList, "", "",
+              "Keys of this case whose values may lie outside their plausible range (a deliberate outlier, e.g. "
+              "[rotor.rpm]); recorded in resolved_case.json and the report"))};
 }
 
 // The gas, the CFD numerics (stage 1a) and the sampling of its field.
@@ -145,15 +198,17 @@ std::vector<KeyDef> flow_keys() {
              "rhoSimpleFoam (air as a perfect gas, the method's model; its temperature carries no "
              "rotor work, see docs/flow.md \"Compressible gas\") or simpleFoam (constant density "
              "gas.density)"),
-      positive(key("gas.density", T::Real, "kg/m^3", "1.2",
-                   "Gas density (incompressible model; reference for drag)")),
-      positive(key("gas.viscosity", T::Real, "Pa s", "1.8e-5", "Gas dynamic viscosity")),
-      positive(
-          key("gas.temperature", T::Real, "K", "293.15", "Gas temperature (compressible model)")),
-      positive(key("gas.pressure", T::Real, "Pa", "101325",
-                   "Absolute ambient pressure (compressible model)")),
+      plausible(positive(key("gas.density", T::Real, "kg/m^3", "1.2", "Gas density (incompressible model; reference for drag)")),
+                0.1, 10, "a gas at plant conditions", kAirSource, {{"g/cm^3", 1e3}, {"g/m^3", 1e-3}}),
+      plausible(positive(key("gas.viscosity", T::Real, "Pa s", "1.8e-5", "Gas dynamic viscosity")), 5e-6, 5e-5,
+                "a gas at plant conditions", kAirSource, {{"mPa s", 1e-3}, {"uPa s", 1e-6}, {"P", 0.1}}),
+      plausible(positive(key("gas.temperature", T::Real, "K", "293.15", "Gas temperature (compressible model)")), 200, 900,
+                "a gas at plant conditions", kPlantTemperatureSource, {{"degC", 1, 273.15}}),
+      plausible(positive(key("gas.pressure", T::Real, "Pa", "101325", "Absolute ambient pressure (compressible model)")),
+                5e4, 5e5, "a plant's absolute gas pressure", kPlantPressureSource,
+                {{"kPa", 1e3}, {"bar", 1e5}, {"atm", 101325}, {"MPa", 1e6}}),
       key("gas.outlet_pressure_drop", T::Real, "Pa", "0",
-          "Outlet static pressure below inlet total pressure"),
+          "Outlet static pressure below inlet total pressure (below gas.pressure: the outlet stays above vacuum)"),
 
       // --- CFD numerics ---
       choice("flow.mesh_preset", "quick", {"tiny", "quick", "medium", "reference"},
@@ -198,8 +253,10 @@ std::vector<KeyDef> flow_keys() {
 // The ore injection and the lumps' transport (stage 1b), and the ore card.
 std::vector<KeyDef> transport_keys() {
   return {// --- ore injection (stage 1 transport) ---
-          at_least(key("injection.n_lumps", T::Int, "", "360", "Number of ore lumps injected"), 1),
-          positive(key("injection.lump_diameter", T::Real, "m", "0.04", "Lump diameter")),
+          range(key("injection.n_lumps", T::Int, "", "360", "Number of ore lumps injected (at most 1e5: a plan limit)"), 1,
+                false, 1e5, false),
+          plausible(positive(key("injection.lump_diameter", T::Real, "m", "0.04", "Lump diameter")), 0.002, 0.5,
+                    "a beater mill's feed", kFeedSource, kMetreSlips),
           positive(key("injection.duration", T::Real, "s", "0.2",
                        "Lumps are inserted evenly over this time")),
           positive(
@@ -225,8 +282,9 @@ std::vector<KeyDef> transport_keys() {
 // The bonded lump (stage 2 and the calibration's specimens).
 std::vector<KeyDef> lump_keys() {
   return {// --- bonded lump model (stage 2) ---
-          at_least(key("lump.n_elements", T::Int, "", "3344", "Elements (spheres) per lump"), 2),
-          positive(key("lump.diameter", T::Real, "m", "0.04", "Lump diameter")),
+          range(key("lump.n_elements", T::Int, "", "3344", "Elements (spheres) per lump"), kMinLumpElements, false, 1e7, false),
+          plausible(positive(key("lump.diameter", T::Real, "m", "0.04", "Lump diameter")), 0.002, 0.5,
+                    "a beater mill's feed", kFeedSource, kMetreSlips),
           range(key("lump.radius_spread", T::Real, "", "0.25",
                     "Element radii uniform in (1 +- spread) x mean"),
                 0, false, 1, true),
@@ -238,7 +296,9 @@ std::vector<KeyDef> lump_keys() {
                        "Bond pairs whose gap is below this x min(Ri, Rj) (0.15: coordination ~6.3 "
                        "at 3344 elements)"),
                    0),
-          at_least(key("lump.max_bonds", T::Int, "", "16", "Cap of bonds per element"), 1),
+          range(key("lump.max_bonds", T::Int, "", "16",
+                    "Cap of bonds per element (at most 64, the limit of fix bond/breakable)"),
+                1, false, 64, false),
           bond_key("lump.bond_radius_multiplier", bond_parameter("radius_multiplier"), "1.0"),
           key("lump.broken_contact", T::Bool, "", "false",
               "Broken bonds stay as compression-only frictional contacts while the pair is within "
@@ -316,7 +376,7 @@ std::vector<KeyDef> breakage_keys() {
 std::vector<KeyDef> calibrate_keys() {
   return {
       // --- calibration (virtual lab tests) ---
-      at_least(key("calibrate.n_elements", T::Int, "", "1500", "Elements in a lab specimen"), 20),
+      range(key("calibrate.n_elements", T::Int, "", "1500", "Elements in a lab specimen"), 20, false, 1e7, false),
       positive(key("calibrate.strain_rate", T::Real, "1/s", "0.5",
                    "Platen strain rate of the UCS and Brazilian tests")),
       at_least(key("calibrate.max_iterations", T::Int, "", "8", "Calibration iterations cap"), 1),
@@ -331,11 +391,9 @@ std::vector<KeyDef> calibrate_keys() {
 std::vector<KeyDef> resources_keys() {
   std::vector<KeyDef> v = {
       // --- resources ---
-      at_least(key("resources.np", T::Int, "", "1", "MPI ranks per engine run (--np overrides)"),
-               1),
-      at_least(key("resources.jobs", T::Int, "", "1",
-                   "Engine runs at once on this machine (--jobs overrides)"),
-               1),
+      range(key("resources.np", T::Int, "", "1", "MPI ranks per engine run (--np overrides)"), 1, false, 1e5, false),
+      range(key("resources.jobs", T::Int, "", "1", "Engine runs at once on this machine (--jobs overrides)"), 1, false,
+            1024, false),
       matching(key("resources.merge.time", T::String, "", "00:20:00",
                    "Cluster: wall-time limit of the small jobs between stages (merges, planning)"),
                kSlurmTime, kSlurmTimeText)};
@@ -366,18 +424,27 @@ Schema make_ore_schema() {
   s.keys = {
       key("name", T::String, "", "", "Ore name"),
       opt(key("source", T::String, "", "", "Where the values come from (citation)")),
-      positive(key("density", T::Real, "kg/m^3", "", "Bulk density")),
-      positive(key("youngs_modulus", T::Real, "Pa", "", "Young's modulus E")),
-      range(key("poisson_ratio", T::Real, "", "", "Poisson's ratio nu"), 0, false, 0.5, true),
-      positive(key("ucs", T::Real, "Pa", "", "Uniaxial compressive strength")),
-      positive(key("tensile_strength", T::Real, "Pa", "", "Tensile strength (Brazilian)")),
-      at_least(key("friction", T::Real, "", "0.5", "Coulomb friction coefficient (element-element and walls)"), 0),
+      plausible(positive(key("density", T::Real, "kg/m^3", "", "Bulk density")), 1000, 8000, "a rock's density",
+                kRockDensitySource, {{"g/cm^3", 1e3}}),
+      plausible(positive(key("youngs_modulus", T::Real, "Pa", "", "Young's modulus E")), 5e8, 2e11,
+                "a rock's Young's modulus", kRockModulusSource, kPascalSlips),
+      plausible(range(key("poisson_ratio", T::Real, "", "", "Poisson's ratio nu"), 0, false, 0.5, true), 0.01, 0.45,
+                "a rock's Poisson's ratio", kPoissonSource, {{"%", 0.01}}),
+      plausible(positive(key("ucs", T::Real, "Pa", "", "Uniaxial compressive strength")), 1e6, 5e8,
+                "a rock's uniaxial compressive strength", kUcsSource, kPascalSlips),
+      plausible(positive(key("tensile_strength", T::Real, "Pa", "", "Tensile strength (Brazilian)")), 1e5, 5e7,
+                "a rock's tensile strength", kTensileSource, kPascalSlips),
+      plausible(at_least(key("friction", T::Real, "", "0.5", "Coulomb friction coefficient (element-element and walls)"), 0),
+                0.05, 1.5, "a rock's friction coefficient", kRockFrictionSource),
       range(key("restitution", T::Real, "", "0.5", "Coefficient of restitution"), 0, true, 1, false),
       // Measured JK drop-weight parameters (Napier-Munn et al. 1996), optional:
       // drawn against the breakage sweep's own fit; they change no simulation.
       opt(range(key("jk.A", T::Real, "%", "", "Measured JK breakage parameter A: the largest t10 of the ore (drop-weight test); give with jk.b"), 0, true, 100, false)),
       opt(range(key("jk.b", T::Real, "t/kWh", "", "Measured JK breakage parameter b (t10 = A (1 - exp(-b Ecs)), Ecs in kWh/t); give with jk.A"), 0, true, 100, false)),
       opt(key("jk.source", T::String, "", "", "Where the measured A and b come from (laboratory, report)")),
+      opt(key(kAllowOutsideRange, T::KeyList, "", "",
+              "Keys of this card whose values may lie outside their plausible range (a deliberate outlier, e.g. "
+              "[ucs]); recorded in resolved_case.json and the report")),
   };
   // Calibrated micro parameters (written by `--stage calibrate`, optional):
   // one key per fitted row of kBondParameters, and the hash they were fitted to.
@@ -424,23 +491,51 @@ std::string type_name(KeyType t) {
     case KeyType::Path: return "file path";
     case KeyType::RealList: return "list of numbers";
     case KeyType::IntList: return "list of integers";
+    case KeyType::KeyList: return "list of key names";
   }
   return "?";
 }
 
+std::string num(double v) {
+  std::string t = fmt::format("{:.6g}", v);
+  const size_t e = t.find('e');
+  if (e == std::string::npos) return t;
+  std::string exp = t.substr(e + 1);
+  const bool negative = exp[0] == '-';
+  exp.erase(0, exp.find_first_not_of("+-0"));
+  return t.substr(0, e) + "e" + (negative ? "-" : "") + exp;
+}
+
+std::string slip_hint(const KeyDef& k, double v) {
+  if (!k.plausible) return "";
+  std::string hint;
+  for (const UnitSlip& s : k.plausible->slips) {
+    const double si = v * s.factor + s.offset;
+    if (si >= k.plausible->lo && si <= k.plausible->hi)
+      hint += fmt::format("{}{} {} ({}{})", hint.empty() ? "" : " or ", num(v), s.unit, num(si),
+                          k.unit.empty() ? "" : " " + k.unit);
+  }
+  return hint;
+}
+
 std::string expected_text(const KeyDef& k) {
   if (!k.pattern_text.empty()) return k.pattern_text;
+  if (k.type == KeyType::KeyList) return "a list of keys of this file that have a plausible range";
   if (k.type == KeyType::Choice) {
     std::string s = "one of ";
     for (size_t i = 0; i < k.choices.size(); ++i) s += (i ? ", " : "") + k.choices[i];
     return s;
   }
   std::string unit = k.unit.empty() ? "" : " " + k.unit;
+  // Whole-number bounds in full (10000000), others as num() writes them (5e8).
+  const auto bound = [&](double b) {
+    return k.type == KeyType::Int || k.type == KeyType::IntList ? fmt::format("{}", static_cast<long long>(b)) : num(b);
+  };
   if (k.min && k.max)
-    return fmt::format("{} in {}{:g}, {:g}{}{}", type_name(k.type), k.min_exclusive ? "(" : "[", *k.min,
-                       *k.max, k.max_exclusive ? ")" : "]", unit);
-  if (k.min) return fmt::format("{} {} {:g}{}", type_name(k.type), k.min_exclusive ? ">" : ">=", *k.min, unit);
-  if (k.max) return fmt::format("{} {} {:g}{}", type_name(k.type), k.max_exclusive ? "<" : "<=", *k.max, unit);
+    return fmt::format("{} in {}{}, {}{}{}", type_name(k.type), k.min_exclusive ? "(" : "[", bound(*k.min),
+                       bound(*k.max), k.max_exclusive ? ")" : "]", unit);
+  if (k.min) return fmt::format("{} {} {}{}", type_name(k.type), k.min_exclusive ? ">" : ">=", bound(*k.min), unit);
+  if (k.max) return fmt::format("{} {} {}{}", type_name(k.type), k.max_exclusive ? "<" : "<=", bound(*k.max), unit);
   return type_name(k.type) + (unit.empty() ? "" : " (" + k.unit + ")");
 }
 
@@ -452,6 +547,19 @@ void table(std::ostringstream& o, const Schema& s) {
     std::string def = k.default_yaml.empty() ? (k.optional ? "(optional)" : "(required)") : "`" + k.default_yaml + "`";
     o << "| `" << k.path << "` | " << type_name(k.type) << " | " << (k.unit.empty() ? "-" : k.unit) << " | "
       << def << " | " << expected_text(k) << " | " << k.doc << " |\n";
+  }
+}
+// The plausible ranges of a schema, with their sources and the unit slips named.
+void plausible_table(std::ostringstream& o, const Schema& s) {
+  o << "| key | plausible | unit slips named | source |\n";
+  o << "|---|---|---|---|\n";
+  for (const auto& k : s.keys) {
+    if (!k.plausible) continue;
+    std::string slips;
+    for (const auto& u : k.plausible->slips) slips += (slips.empty() ? "" : ", ") + u.unit;
+    o << "| `" << k.path << "` | " << num(k.plausible->lo) << " to " << num(k.plausible->hi)
+      << (k.unit.empty() ? "" : " " + k.unit) << " (" << k.plausible->what << ") | " << (slips.empty() ? "-" : slips)
+      << " | " << k.plausible->source << " |\n";
   }
 }
 }  // namespace
@@ -466,6 +574,17 @@ std::string schema_markdown() {
   table(o, case_schema());
   o << "\n## Ore card (`liggghts_inputs/materials/*.yaml`)\n\n";
   table(o, ore_schema());
+  o << "\n## Plausible ranges\n\n"
+    << "A physical key of the case or the ore card also has a plausible range: the values a real rock, gas or\n"
+    << "mill takes. A value outside it is an error that names the file, the key, the value and the unit it was\n"
+    << "likely typed in (`ucs: 50 Pa: did you mean 50 MPa (5e7 Pa)?`). A deliberate outlier is allowed by\n"
+    << "listing its key in `" << kAllowOutsideRange << "` of the same file (the case for case keys, the ore card\n"
+    << "for card keys), e.g. `" << kAllowOutsideRange << ": [ucs]`; the list is kept in resolved_case.json and\n"
+    << "shown at the top of the report. The hard bounds of the tables above hold even then.\n\n"
+    << "### Case file\n\n";
+  plausible_table(o, case_schema());
+  o << "\n### Ore card\n\n";
+  plausible_table(o, ore_schema());
   return o.str();
 }
 

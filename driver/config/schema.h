@@ -9,7 +9,26 @@
 
 namespace mill::config {
 
-enum class KeyType { Int, Real, Bool, String, Choice, Path, RealList, IntList };
+// KeyList: names of other keys of the same file (allow_outside_range).
+enum class KeyType { Int, Real, Bool, String, Choice, Path, RealList, IntList, KeyList };
+
+// A unit a value is often typed in by mistake: value x factor + offset is the
+// value in the key's own unit (MPa for Pa: factor 1e6; degC for K: offset 273.15).
+struct UnitSlip {
+  std::string unit;
+  double factor = 1;
+  double offset = 0;
+};
+
+// The values a real rock, gas or mill takes. A value outside them is an error
+// that names the likely unit slip, unless the file lists the key in its
+// allow_outside_range (a deliberate outlier).
+struct Plausible {
+  double lo = 0, hi = 0;
+  std::string what;    // what the bounds describe: "a rock's uniaxial compressive strength"
+  std::string source;  // the handbook or paper the bounds come from
+  std::vector<UnitSlip> slips;
+};
 
 // One declared key. `path` is dotted ("rotor.rpm"); `default_yaml` is the
 // default written as YAML ("" = required key, no default).
@@ -27,6 +46,7 @@ struct KeyDef {
   bool optional = false;             // may be absent with no default
   std::string pattern;               // String: ECMAScript regex the whole value must match
   std::string pattern_text;          // String: what the pattern admits, for messages and docs
+  std::optional<Plausible> plausible;  // numbers: the range a real rock, gas or mill takes
 };
 
 // What a table describes: used in messages ("case file", "ore card").
@@ -44,6 +64,18 @@ const Schema& ore_schema();
 std::string type_name(KeyType t);
 // Human text for the admissible range of a key: "> 0", "in [0, 0.5)", "one of a, b".
 std::string expected_text(const KeyDef& k);
+// Fewest elements of a lump: below ten, LIGGGHTS' insert/pack in the packing
+// deck (liggghts_inputs/lump_build.in.tmpl) places only one element in its
+// sphere, whatever the seed.
+inline constexpr long kMinLumpElements = 10;
+// The key that lists a file's deliberate outliers of their plausible range.
+inline constexpr const char* kAllowOutsideRange = "allow_outside_range";
+// Text for a number in messages and docs: 50, 5e7, 1.869e10 (no "e+07").
+std::string num(double v);
+// The units a value outside its plausible range was likely typed in, as
+// "50 MPa (5e7 Pa)" pieces joined by " or "; "" when no slip fits.
+std::string slip_hint(const KeyDef& k, double v);
+
 // The schema as a Markdown document (for --print-schema and docs/config.md).
 std::string schema_markdown();
 

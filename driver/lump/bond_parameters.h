@@ -85,8 +85,8 @@ inline constexpr BondParameter kBondParameters[] = {
    "Bond Mohr-Coulomb friction angle"},
   {&BondParams::moment_factor,      "moment_factor",      "bond_moment_factor",    "moment_factor",   "moment_factor",     "",    {0, false, 1, false},        1.0,       true,
    "Share of the bond moments in the bond stresses (absent: 1)"},
-  {&BondParams::radius_multiplier,  "radius_multiplier",  nullptr,                 "radius_mult",     "radius_multiplier", "",    kPositive,                   kFromCard, false,
-   "Bond disc radius = multiplier x min(Ri, Rj)"},  // the case's lump.bond_radius_multiplier
+  {&BondParams::radius_multiplier,  "radius_multiplier",  nullptr,                 "radius_mult",     "radius_multiplier", "",    {0, true, 2, false},         kFromCard, false,
+   "Bond disc radius = multiplier x min(Ri, Rj); at most 2, a disc twice the smaller element (Potyondy & Cundall 2004 use 1)"},  // the case's lump.bond_radius_multiplier
 };
 // clang-format on
 

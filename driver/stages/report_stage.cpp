@@ -180,6 +180,24 @@ void unconverged_banner(std::ostringstream& o, nlohmann::json& summary) {
   summary["unconverged_flow"] = unconverged;
 }
 
+// Values the case or its ore card keeps outside their plausible range
+// (allow_outside_range): say so first (and in summary.json).
+void outlier_banner(std::ostringstream& o, const config::CaseConfig& cfg, nlohmann::json& summary) {
+  const nlohmann::json all = config::outliers(cfg);
+  if (all.empty()) return;
+  o << "<div class=bad><b>Values outside their plausible range</b>, kept on purpose "
+       "(<code>allow_outside_range</code>):<ul>\n";
+  for (const auto& x : all) {
+    const std::string unit = x["unit"].get<std::string>().empty() ? "" : " " + x["unit"].get<std::string>();
+    o << "<li><code>" << esc(x["key"].get<std::string>()) << "</code> = " << config::num(x["value"].get<double>()) << esc(unit)
+      << " (plausible " << config::num(x["plausible"][0].get<double>()) << " to "
+      << config::num(x["plausible"][1].get<double>()) << esc(unit) << ") in " << esc(x["file"].get<std::string>())
+      << "</li>\n";
+  }
+  o << "</ul></div>\n";
+  summary["outside_plausible_range"] = all;
+}
+
 // The headline: a short table in words and units, grouped by stage.
 void headline_table(std::ostringstream& o, const std::vector<report::HeadlineRow>& rows) {
   o << "<h2>Headline</h2>\n";
@@ -380,6 +398,7 @@ void ReportStage::run_job(StageContext& ctx, const JobSpec&, const fs::path&) {
   std::ostringstream o;
   page_intro(o, ctx.cfg);
   unconverged_banner(o, summary);
+  outlier_banner(o, ctx.cfg, summary);
   headline_table(o, rows);
   case_section(o, ctx.cfg, figures);
   const std::vector<std::pair<std::string, std::string>> sections = {
