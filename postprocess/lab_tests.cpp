@@ -1,4 +1,5 @@
-// Virtual lab tests: load curves, elastic constants, strengths, calibration step.
+// Virtual lab tests: load curves, elastic constants, strengths, failure envelope,
+// fracture toughness, calibration step.
 #include "postprocess/lab_tests.h"
 
 #include <fmt/format.h>
@@ -11,29 +12,59 @@
 
 namespace mill::post {
 
-// Read the deck's curve file; comment lines start with '#'.
-LoadCurve ReadLoadCurve(const std::string& file) {
+namespace {
+// The numeric rows of a deck's curve file (comment lines start with '#'),
+// each with at least `columns` numbers; `names` lists them for the error.
+std::vector<std::vector<double>> ReadCurveRows(const std::string& file, size_t columns,
+                                               const char* names) {
   std::ifstream in(file);
   if (!in) throw std::runtime_error(file + ": cannot open the load curve");
-  LoadCurve c;
+  std::vector<std::vector<double>> rows;
   std::string line;
   int lineno = 0;
   while (std::getline(in, line)) {
     ++lineno;
     if (line.empty() || line[0] == '#') continue;
     std::istringstream ss(line);
-    double step, t, d, ft, fb, lat, nb, nbroken;
-    if (!(ss >> step >> t >> d >> ft >> fb >> lat >> nb >> nbroken))
-      throw std::runtime_error(
-          fmt::format("{}:{}: expected 8 numbers (step time displacement force_top "
-                      "force_bottom lateral_strain bonds broken), got '{}'",
-                      file, lineno, line));
-    c.time.push_back(t);
-    c.displacement.push_back(d);
-    c.force_top.push_back(ft);
-    c.force_bottom.push_back(fb);
-    c.lateral_strain.push_back(lat);
-    c.broken_bonds.push_back(nbroken);
+    std::vector<double> row(columns);
+    for (double& v : row)
+      if (!(ss >> v))
+        throw std::runtime_error(fmt::format("{}:{}: expected {} numbers ({}), got '{}'", file,
+                                             lineno, columns, names, line));
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+// The load-curve columns of one row: step time displacement f_top f_bottom
+// lateral_strain bonds broken.
+void AppendLoadRow(const std::vector<double>& r, LoadCurve& c) {
+  c.time.push_back(r[1]);
+  c.displacement.push_back(r[2]);
+  c.force_top.push_back(r[3]);
+  c.force_bottom.push_back(r[4]);
+  c.lateral_strain.push_back(r[5]);
+  c.broken_bonds.push_back(r[7]);
+}
+}  // namespace
+
+// Read the deck's curve file; comment lines start with '#'.
+LoadCurve ReadLoadCurve(const std::string& file) {
+  LoadCurve c;
+  for (const auto& r : ReadCurveRows(
+           file, 8, "step time displacement force_top force_bottom lateral_strain bonds broken"))
+    AppendLoadRow(r, c);
+  return c;
+}
+
+// Read the triaxial deck's curve file: the load curve plus the confining force.
+TriaxialCurve ReadTriaxialCurve(const std::string& file) {
+  TriaxialCurve c;
+  for (const auto& r : ReadCurveRows(file, 9,
+                                     "step time displacement force_top force_bottom "
+                                     "lateral_strain bonds broken confining_force")) {
+    AppendLoadRow(r, c.load);
+    c.confining_force.push_back(r[8]);
   }
   return c;
 }
@@ -137,6 +168,122 @@ BrazilianResult AnalyseBrazilian(const LoadCurve& c, double diameter_m, double t
     throw std::runtime_error("Brazilian test: the disc never carried a load");
   r.displacement_at_peak = c.displacement[r.peak_index];
   r.tensile_strength = BrazilianTensileStrength(r.peak_force, diameter_m, thickness_m);
+  return r;
+}
+
+// Peak of the deviatoric stress of a triaxial test.
+TriaxialResult AnalyseTriaxial(const TriaxialCurve& c, double gauge_length_m, double end_area_m2,
+                               double lateral_area_m2) {
+  if (!(gauge_length_m > 0) || !(end_area_m2 > 0) || !(lateral_area_m2 > 0))
+    throw std::invalid_argument(fmt::format(
+        "triaxial test: gauge length, end area and lateral area must be > 0, got {} m, {} m^2, "
+        "{} m^2",
+        gauge_length_m, end_area_m2, lateral_area_m2));
+  if (c.load.size() == 0 || c.confining_force.size() != c.load.size())
+    throw std::runtime_error("triaxial test: empty load curve, or a confining force missing");
+  TriaxialResult r;
+  std::vector<double> dev(c.load.size());
+  for (size_t i = 0; i < dev.size(); ++i)
+    dev[i] = c.load.force(i) / end_area_m2 - c.confining_force[i] / lateral_area_m2;
+  r.peak_index = argmax(dev);
+  r.deviator = dev[r.peak_index];
+  if (!(r.deviator > 0))
+    throw std::runtime_error("triaxial test: the axial stress never exceeded the confinement");
+  r.sigma3 = c.confining_force[r.peak_index] / lateral_area_m2;
+  r.sigma1 = r.sigma3 + r.deviator;
+  r.strain_at_peak = c.load.displacement[r.peak_index] / gauge_length_m;
+  r.broken_before_loading = c.load.broken_bonds.front();
+  return r;
+}
+
+namespace {
+// The least-squares line y = slope x + intercept through (x_k, y_k); throws
+// unless there are two distinct x.
+LinearFit FitStrengthLine(const std::vector<double>& x, const std::vector<double>& y,
+                          const char* what) {
+  const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+  if (x.size() < 2 || !(*hi > *lo))
+    throw std::invalid_argument(fmt::format(
+        "{}: need peaks at two different confinements, got {} point(s)", what, x.size()));
+  return FitLine(x, y, 0, x.size() - 1);
+}
+}  // namespace
+
+// Mohr-Coulomb line through the peaks, and its friction angle and cohesion.
+MohrCoulomb FitMohrCoulomb(const std::vector<StrengthPoint>& points) {
+  std::vector<double> x, y;
+  for (const auto& p : points) x.push_back(p.sigma3), y.push_back(p.sigma1);
+  const LinearFit f = FitStrengthLine(x, y, "Mohr-Coulomb fit");
+  MohrCoulomb mc;
+  mc.ucs = f.intercept;
+  mc.q = f.slope;
+  if (!(mc.q > 1) || !(mc.ucs > 0))
+    throw std::runtime_error(
+        fmt::format("Mohr-Coulomb fit: sigma_1 = {:.4g} Pa + {:.4g} sigma_3 has no positive "
+                    "friction angle and cohesion (need a slope > 1 and an intercept > 0)",
+                    mc.ucs, mc.q));
+  // q = (1 + sin phi) / (1 - sin phi)  <=>  sin phi = (q - 1) / (q + 1).
+  const double sin_phi = (mc.q - 1) / (mc.q + 1);
+  const double phi = std::asin(sin_phi);
+  mc.friction_angle_deg = phi * 180.0 / M_PI;
+  mc.cohesion = mc.ucs * (1 - sin_phi) / (2 * std::cos(phi));
+  return mc;
+}
+
+// Hoek & Brown (1997), eq. 2, intact rock (s = 1, a = 1/2).
+double HoekBrown::Sigma1(double sigma3) const {
+  return sigma3 + sigma_ci * std::sqrt(m_i * sigma3 / sigma_ci + 1);
+}
+
+// sigma_ci and m_i from the regression of (sigma_1 - sigma_3)^2 on sigma_3.
+HoekBrown FitHoekBrown(const std::vector<StrengthPoint>& points) {
+  std::vector<double> x, y;
+  for (const auto& p : points) x.push_back(p.sigma3), y.push_back(std::pow(p.sigma1 - p.sigma3, 2));
+  const LinearFit f = FitStrengthLine(x, y, "Hoek-Brown fit");
+  if (!(f.intercept > 0) || !(f.slope > 0))
+    throw std::runtime_error(fmt::format(
+        "Hoek-Brown fit: (sigma_1 - sigma_3)^2 = {:.4g} Pa^2 + {:.4g} Pa sigma_3 gives no "
+        "positive sigma_ci and m_i",
+        f.intercept, f.slope));
+  HoekBrown hb;
+  hb.sigma_ci = std::sqrt(f.intercept);
+  hb.m_i = f.slope / hb.sigma_ci;
+  return hb;
+}
+
+// Kuruppu et al. (2014), eq. 2.
+double ScbGeometryFactor(double notch_ratio, double span_ratio) {
+  if (!(notch_ratio > 0 && notch_ratio < 1) || !(span_ratio > 0 && span_ratio < 1))
+    throw std::invalid_argument(
+        fmt::format("SCB test: need 0 < a/R < 1 and 0 < s/R < 1, got a/R = {}, s/R = {}",
+                    notch_ratio, span_ratio));
+  const double b = notch_ratio, sr = span_ratio;
+  return -1.297 + 9.516 * sr - (0.47 + 16.457 * sr) * b + (1.071 + 34.401 * sr) * b * b;
+}
+
+// Kuruppu et al. (2014), eq. 1.
+double ScbToughness(double force_N, double radius_m, double thickness_m, double notch_m,
+                    double half_span_m) {
+  if (!(radius_m > 0) || !(thickness_m > 0))
+    throw std::invalid_argument(fmt::format(
+        "SCB test: radius and thickness must be > 0, got {} m, {} m", radius_m, thickness_m));
+  const double y = ScbGeometryFactor(notch_m / radius_m, half_span_m / radius_m);
+  return y * force_N * std::sqrt(M_PI * notch_m) / (2 * radius_m * thickness_m);
+}
+
+// Peak load of the half disc and its toughness.
+ScbResult AnalyseScb(const LoadCurve& c, double radius_m, double thickness_m, double notch_m,
+                     double half_span_m) {
+  if (c.size() == 0) throw std::runtime_error("SCB test: empty load curve");
+  ScbResult r;
+  std::vector<double> f(c.size());
+  for (size_t i = 0; i < c.size(); ++i) f[i] = c.force(i);
+  r.peak_index = argmax(f);
+  r.peak_force = f[r.peak_index];
+  if (!(r.peak_force > 0)) throw std::runtime_error("SCB test: the specimen never carried a load");
+  r.displacement_at_peak = c.displacement[r.peak_index];
+  r.geometry_factor = ScbGeometryFactor(notch_m / radius_m, half_span_m / radius_m);
+  r.toughness = ScbToughness(r.peak_force, radius_m, thickness_m, notch_m, half_span_m);
   return r;
 }
 

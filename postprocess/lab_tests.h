@@ -1,6 +1,7 @@
 // Virtual laboratory tests of the bonded ore: reading the load curves the
-// UCS and Brazilian decks write, turning them into stress and strain, the
-// elastic constants and strengths, and the update step of the calibration.
+// UCS, Brazilian, triaxial and semi-circular bend decks write, turning them
+// into stress and strain, the elastic constants, strengths, failure envelope
+// and fracture toughness, and the update step of the calibration.
 // Pure functions (no engine, no driver).
 #pragma once
 
@@ -77,6 +78,99 @@ struct BrazilianResult {
   size_t peak_index = 0;
 };
 BrazilianResult AnalyseBrazilian(const LoadCurve& c, double diameter_m, double thickness_m);
+
+// One triaxial run as written by liggghts_inputs/triaxial.in.tmpl: the load
+// curve of the axial stage (total axial forces, sigma_1 x end area) and the
+// inward radial force applied to the lateral shell at each sample.
+struct TriaxialCurve {
+  LoadCurve load;
+  std::vector<double> confining_force;  // N, summed over the shell
+};
+
+// Read a triaxial curve file (`# ...` comments, then: step time displacement
+// f_top f_bottom lateral_strain bonds broken confining_force). Throws with the
+// file name and line on a bad line.
+TriaxialCurve ReadTriaxialCurve(const std::string& file);
+
+// What a triaxial test gives: the peak of the deviatoric stress
+// sigma_1 - sigma_3 and the principal stresses there (compression > 0).
+struct TriaxialResult {
+  double sigma3 = 0;    // Pa, confinement at the peak: confining force / lateral area
+  double sigma1 = 0;    // Pa, axial stress at the peak: mean platen force / end area
+  double deviator = 0;  // Pa, sigma1 - sigma3
+  double strain_at_peak = 0;
+  size_t peak_index = 0;
+  double broken_before_loading = 0;  // bonds the confinement broke (first sample)
+};
+
+// The peak is that of sigma_1 - sigma_3 (the deck's stopping rule watches the
+// same quantity). Throws when a length or an area is not > 0, or when the
+// deviatoric stress never becomes positive.
+TriaxialResult AnalyseTriaxial(const TriaxialCurve& c, double gauge_length_m, double end_area_m2,
+                               double lateral_area_m2);
+
+// A peak strength: the principal stresses at failure (compression > 0), Pa.
+struct StrengthPoint {
+  double sigma3 = 0, sigma1 = 0;
+};
+
+// The Mohr-Coulomb envelope in principal stresses,
+//   sigma_1 = ucs + q sigma_3,  q = (1 + sin phi) / (1 - sin phi),
+//   c = ucs (1 - sin phi) / (2 cos phi)
+// (the Coulomb criterion written with the principal stresses: Jaeger, Cook &
+// Zimmerman 2007, ch. 4).
+struct MohrCoulomb {
+  double ucs = 0;                 // Pa, sigma_1 at sigma_3 = 0
+  double q = 0;                   // d sigma_1 / d sigma_3
+  double friction_angle_deg = 0;  // phi
+  double cohesion = 0;            // Pa
+  double Sigma1(double sigma3) const { return ucs + q * sigma3; }
+};
+
+// Least-squares line sigma_1 = ucs + q sigma_3 through the points (exact
+// through two), and phi and c from it. Throws with fewer than two distinct
+// confinements, or when q <= 1 (no positive friction angle) or ucs <= 0.
+MohrCoulomb FitMohrCoulomb(const std::vector<StrengthPoint>& points);
+
+// The Hoek-Brown criterion of intact rock,
+//   sigma_1 = sigma_3 + sigma_ci sqrt(m_i sigma_3 / sigma_ci + 1)
+// (Hoek & Brown 1997, eq. 2). With y = (sigma_1 - sigma_3)^2 and
+// x = sigma_3 it is the line y = m_i sigma_ci x + sigma_ci^2, fitted by least
+// squares (the regression of Hoek & Brown 1997, appendix; exact through two
+// points).
+struct HoekBrown {
+  double sigma_ci = 0;  // Pa, uniaxial compressive strength of the intact rock
+  double m_i = 0;
+  double Sigma1(double sigma3) const;
+};
+
+// Throws with fewer than two distinct confinements, or when the fit gives
+// sigma_ci^2 <= 0 or m_i <= 0.
+HoekBrown FitHoekBrown(const std::vector<StrengthPoint>& points);
+
+// The dimensionless stress intensity factor of the semi-circular bend
+// specimen, Y' = -1.297 + 9.516 s/R - (0.47 + 16.457 s/R) beta
+// + (1.071 + 34.401 s/R) beta^2, beta = a/R (Kuruppu et al. 2014, eq. 2: a
+// fit to finite-element results for the suggested geometry, s/R from 0.5 to
+// 0.8 and a/R from 0.4 to 0.6). Throws unless 0 < a/R < 1 and 0 < s/R < 1.
+double ScbGeometryFactor(double notch_ratio, double span_ratio);
+
+// Mode-I fracture toughness from the peak load P of a semi-circular bend
+// test: K_IC = Y' P sqrt(pi a) / (2 R B) (Kuruppu et al. 2014, eq. 1), in
+// Pa m^0.5. R radius, B thickness, a notch length, s half the support span.
+double ScbToughness(double force_N, double radius_m, double thickness_m, double notch_m,
+                    double half_span_m);
+
+struct ScbResult {
+  double peak_force = 0;       // N
+  double geometry_factor = 0;  // Y'
+  double toughness = 0;        // Pa m^0.5
+  double displacement_at_peak = 0;
+  size_t peak_index = 0;
+};
+// The peak of the mean of the load-point and support forces, and K_IC there.
+ScbResult AnalyseScb(const LoadCurve& c, double radius_m, double thickness_m, double notch_m,
+                     double half_span_m);
 
 // One calibration update of a micro parameter x towards a macro target.
 // The response y(x) is modelled locally as a power law (log_response) or as

@@ -1,6 +1,8 @@
 // Virtual lab tests on hand-made data: stress and strain of a load curve with
-// known E, nu and peak; the Brazilian formula; the calibration step on
-// analytic response models.
+// known E, nu and peak; the Brazilian formula; the triaxial curve and peak;
+// the Mohr-Coulomb and Hoek-Brown envelopes of synthetic peaks; the
+// semi-circular bend toughness; the calibration step on analytic response
+// models.
 #include "postprocess/lab_tests.h"
 
 #include <gtest/gtest.h>
@@ -121,6 +123,146 @@ TEST(LabTests, ReadsTheDeckCurveFormatAndNamesABadLine) {
     EXPECT_NE(std::string(e.what()).find(":4:"), std::string::npos) << e.what();
   }
   std::remove(name);
+}
+
+// A triaxial curve file as the deck writes it: the confining force column is
+// read, a line that lacks it is named.
+TEST(LabTestsTriaxial, ReadsTheCurveFileWithTheConfiningForce) {
+  char name[] = "/tmp/triax_curve_XXXXXX";
+  const int fd = mkstemp(name);
+  ASSERT_GE(fd, 0);
+  close(fd);
+  {
+    std::ofstream o(name);
+    o << "# step time displacement_m force_top_N force_bottom_N lateral_strain bonds broken "
+         "confining_force_N\n"
+      << "10800 8.0e-4 2.7e-08 1210.5 1207.7 1.3e-08 1081 0 7604.2\n"
+      << "11040 8.2e-4 2.9e-07 1247.8 1247.2 1.7e-06 1081 2 7604.3\n";
+  }
+  const TriaxialCurve c = ReadTriaxialCurve(name);
+  ASSERT_EQ(c.load.size(), 2u);
+  ASSERT_EQ(c.confining_force.size(), 2u);
+  EXPECT_DOUBLE_EQ(c.confining_force[1], 7604.3);
+  EXPECT_DOUBLE_EQ(c.load.force(1), 1247.5);
+  EXPECT_DOUBLE_EQ(c.load.broken_bonds[1], 2.0);
+  EXPECT_DOUBLE_EQ(c.load.lateral_strain[1], 1.7e-06);
+  // A UCS curve (8 columns) is not a triaxial curve.
+  {
+    std::ofstream o(name, std::ios::app);
+    o << "11280 8.4e-4 5.5e-07 1290.0 1290.6 3.4e-06 1081 2\n";
+  }
+  try {
+    ReadTriaxialCurve(name);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(":4: expected 9 numbers"), std::string::npos) << e.what();
+  }
+  std::remove(name);
+}
+
+// Peak of sigma_1 - sigma_3 of a hand-made curve: a confinement of 5 MPa on a
+// lateral area A_lat, an axial stress that rises from 5 MPa to a peak of
+// 30 MPa and falls.
+TEST(LabTestsTriaxial, PeakOfTheDeviatoricStress) {
+  const double A = 2.4e-4, A_lat = 1.5e-3, L = 0.03, p = 5e6;
+  TriaxialCurve c;
+  for (int i = 0; i <= 100; ++i) {
+    const double eps = 2e-5 * i;
+    const double dev = 25e6 * std::sin(M_PI * i / 120.0);  // peak at i = 60
+    c.load.time.push_back(1e-5 * i);
+    c.load.displacement.push_back(eps * L);
+    c.load.force_top.push_back((p + dev) * A * 1.01);
+    c.load.force_bottom.push_back((p + dev) * A * 0.99);
+    c.load.lateral_strain.push_back(0.0);
+    c.load.broken_bonds.push_back(3.0 + i);
+    c.confining_force.push_back(p * A_lat);
+  }
+  const TriaxialResult r = AnalyseTriaxial(c, L, A, A_lat);
+  EXPECT_EQ(r.peak_index, 60u);
+  EXPECT_NEAR(r.sigma3, p, 1e-6);
+  EXPECT_NEAR(r.deviator, 25e6, 1e-3);
+  EXPECT_NEAR(r.sigma1, 30e6, 1e-3);
+  EXPECT_NEAR(r.strain_at_peak, 60 * 2e-5, 1e-15);
+  EXPECT_DOUBLE_EQ(r.broken_before_loading, 3.0);
+  EXPECT_THROW(AnalyseTriaxial(c, L, A, 0.0), std::invalid_argument);
+}
+
+// Peaks on a known Mohr-Coulomb envelope (phi 35 deg, c 10 MPa): the fit
+// gives phi and c back to round-off, from three points and from two.
+TEST(LabTestsTriaxial, MohrCoulombFitRecoversFrictionAngleAndCohesion) {
+  const double phi = 35.0 * M_PI / 180.0, c = 10e6;
+  const double q = (1 + std::sin(phi)) / (1 - std::sin(phi));
+  const double ucs = 2 * c * std::cos(phi) / (1 - std::sin(phi));
+  std::vector<StrengthPoint> pts;
+  for (double s3 : {0.0, 5e6, 20e6}) pts.push_back({s3, ucs + q * s3});
+  for (size_t n : {size_t(3), size_t(2)}) {
+    const MohrCoulomb mc = FitMohrCoulomb(std::vector<StrengthPoint>(pts.begin(), pts.begin() + n));
+    EXPECT_NEAR(mc.friction_angle_deg, 35.0, 1e-9) << n << " points";
+    EXPECT_NEAR(mc.cohesion / c, 1.0, 1e-12) << n << " points";
+    EXPECT_NEAR(mc.ucs / ucs, 1.0, 1e-12);
+    EXPECT_NEAR(mc.q, q, 1e-12);
+    EXPECT_NEAR(mc.Sigma1(20e6), pts[2].sigma1, 1e-6);
+  }
+  // q = tan^2(45 deg + phi/2), the textbook form of the same slope.
+  EXPECT_NEAR(q, std::pow(std::tan(M_PI / 4 + phi / 2), 2), 1e-12);
+}
+
+TEST(LabTestsTriaxial, MohrCoulombFitNeedsTwoConfinementsAndFriction) {
+  EXPECT_THROW(FitMohrCoulomb({{5e6, 40e6}}), std::invalid_argument);
+  EXPECT_THROW(FitMohrCoulomb({{5e6, 40e6}, {5e6, 41e6}}), std::invalid_argument);
+  // Strength falls with confinement: no friction angle.
+  EXPECT_THROW(FitMohrCoulomb({{0.0, 40e6}, {5e6, 42e6}}), std::runtime_error);
+}
+
+// Peaks on a known Hoek-Brown envelope of intact rock (sigma_ci 100 MPa,
+// m_i 12): the regression gives both back, from four points and from two.
+TEST(LabTestsTriaxial, HoekBrownFitRecoversMi) {
+  const HoekBrown truth{100e6, 12.0};
+  std::vector<StrengthPoint> pts;
+  for (double s3 : {0.0, 5e6, 10e6, 20e6}) pts.push_back({s3, truth.Sigma1(s3)});
+  EXPECT_NEAR(pts[0].sigma1, 100e6, 1e-6);  // sigma_1 = sigma_ci at sigma_3 = 0
+  for (size_t n : {size_t(4), size_t(2)}) {
+    const HoekBrown hb = FitHoekBrown(std::vector<StrengthPoint>(pts.begin(), pts.begin() + n));
+    EXPECT_NEAR(hb.m_i, 12.0, 1e-9) << n << " points";
+    EXPECT_NEAR(hb.sigma_ci / 100e6, 1.0, 1e-12) << n << " points";
+  }
+  // Without the unconfined point: two confined peaks fix both constants.
+  const HoekBrown hb = FitHoekBrown({pts[2], pts[3]});
+  EXPECT_NEAR(hb.m_i, 12.0, 1e-9);
+  EXPECT_NEAR(hb.sigma_ci / 100e6, 1.0, 1e-12);
+  EXPECT_THROW(FitHoekBrown({pts[1]}), std::invalid_argument);
+}
+
+// Y' of Kuruppu et al. (2014), eq. 2, at the corners and centre of the
+// suggested geometry, against the polynomial evaluated by hand to 4 decimals
+// (tolerance 5e-5).
+TEST(LabTestsScb, GeometryFactorOfTheSuggestedGeometry) {
+  EXPECT_NEAR(ScbGeometryFactor(0.5, 0.8), 6.6460, 5e-5);
+  EXPECT_NEAR(ScbGeometryFactor(0.4, 0.5), 2.9050, 5e-5);
+  EXPECT_NEAR(ScbGeometryFactor(0.6, 0.5), 4.8196, 5e-5);
+  EXPECT_NEAR(ScbGeometryFactor(0.4, 0.8), 5.4362, 5e-5);
+  EXPECT_NEAR(ScbGeometryFactor(0.6, 0.8), 8.4275, 5e-5);
+  EXPECT_NEAR(ScbGeometryFactor(0.5, 0.6), 4.6684, 5e-5);
+  // A longer notch or a wider span opens the crack more.
+  EXPECT_GT(ScbGeometryFactor(0.55, 0.7), ScbGeometryFactor(0.45, 0.7));
+  EXPECT_GT(ScbGeometryFactor(0.5, 0.75), ScbGeometryFactor(0.5, 0.65));
+  EXPECT_THROW(ScbGeometryFactor(1.0, 0.8), std::invalid_argument);
+  EXPECT_THROW(ScbGeometryFactor(0.5, 0.0), std::invalid_argument);
+}
+
+// K_IC = Y' P sqrt(pi a) / (2 R B): 1 kN on R 50 mm, B 40 mm, a 25 mm, s 40 mm
+// (a/R 0.5, s/R 0.8) is 0.4656 MPa m^0.5; the peak of a curve gives the same.
+TEST(LabTestsScb, ToughnessFromThePeakLoad) {
+  const double R = 0.05, B = 0.04, a = 0.025, s = 0.04;
+  const double k = ScbToughness(1000.0, R, B, a, s);
+  EXPECT_NEAR(k, 6.6460 * 1000.0 * std::sqrt(M_PI * a) / (2 * R * B), 1e-3 * k);
+  EXPECT_NEAR(k / 1e6, 0.4656, 1e-4);
+  const LoadCurve c = MakeCurve(10e9, 0.0, 1e-3, 0.05, 1e-4);  // peak 775 N
+  const ScbResult r = AnalyseScb(c, R, B, a, s);
+  EXPECT_NEAR(r.peak_force, 775.0, 1.0);
+  EXPECT_DOUBLE_EQ(r.toughness, ScbToughness(r.peak_force, R, B, a, s));
+  EXPECT_DOUBLE_EQ(r.geometry_factor, ScbGeometryFactor(0.5, 0.8));
+  EXPECT_THROW(ScbToughness(1000.0, R, 0.0, a, s), std::invalid_argument);
 }
 
 TEST(LabTests, FitLineRecoversALine) {
