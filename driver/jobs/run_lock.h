@@ -1,0 +1,37 @@
+// The run-folder lock: one command writes into a run folder at a time. A
+// command that runs stages (or `orchestrate impact`) holds an exclusive
+// flock on <run>/orchestrate.lock; the tasks of a scheduler array (--task)
+// hold it shared, so they run side by side but never beside a whole-stage
+// run. The lock file names its holders (pid, host, start, command) for the
+// message of the command that is turned away. The kernel drops the lock when
+// its holder dies, so a killed command never leaves the folder locked.
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+
+namespace mill::jobs {
+
+// Thrown when another command holds the run folder; the message names it.
+struct RunFolderBusy : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+class RunLock {
+ public:
+  enum class Mode { Shared, Exclusive };
+  // Takes the lock without waiting (creating the folder); throws
+  // RunFolderBusy naming the holder when another command has it.
+  RunLock(const std::filesystem::path& run_dir, Mode mode, const std::string& command);
+  ~RunLock();
+  RunLock(const RunLock&) = delete;
+  RunLock& operator=(const RunLock&) = delete;
+
+  static std::filesystem::path file(const std::filesystem::path& run_dir);
+
+ private:
+  int fd_ = -1;
+};
+
+}  // namespace mill::jobs
