@@ -139,6 +139,14 @@ void write_provenance(const config::CaseConfig& cfg, const fs::path& dir, Folder
 
 std::string check_run_folder(const config::CaseConfig& cfg, const fs::path& run_dir, bool force,
                              FolderKind kind, bool read_only) {
+  // A folder inside another run folder would mix into that run's stages.
+  fs::path self = fs::absolute(run_dir).lexically_normal();
+  if (!self.has_filename()) self = self.parent_path();  // "runs/x/"
+  if (const fs::path above = owning_run_folder(self.parent_path()); !above.empty())
+    throw config::ConfigError(fmt::format(
+        "--output {}: inside the run folder {} (it holds resolved_case.json), which belongs to its "
+        "case and stages; use a folder outside it, e.g. --output runs/{}",
+        run_dir.string(), above.string(), cfg.name));
   const Owner o = read_owner(run_dir);
   if (!o.kind.empty() && o.kind != kind_name(kind)) refuse_other_kind(cfg, run_dir, o, kind);
   if (force || o.name.empty()) return "";

@@ -27,11 +27,11 @@ nlohmann::json resolved_inputs(const config::CaseConfig& cfg);
 void write_provenance(const config::CaseConfig& cfg, const std::filesystem::path& dir,
                       FolderKind kind);
 
-// Throws a ConfigError naming the owner when `run_dir` belongs to another
-// case or to another kind of writer, and (unless `force`) when it holds this
-// case's results made with other values (the keys that differ named). A
-// command that only reads (`read_only`: --dry-run, --list-tasks) gets that
-// last one back as a warning instead, to print; else "".
+// Throws a ConfigError naming the owner when `run_dir` lies inside another
+// run folder, belongs to another case or to another kind of writer, and (unless `force`) when it
+// holds this case's results made with other values (the keys that differ named). A command that
+// only reads (`read_only`: --dry-run, --list-tasks) gets that last one back as a warning instead,
+// to print; else "".
 std::string check_run_folder(const config::CaseConfig& cfg, const std::filesystem::path& run_dir,
                              bool force, FolderKind kind = FolderKind::Stages,
                              bool read_only = false);
