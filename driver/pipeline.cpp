@@ -381,42 +381,80 @@ std::vector<std::string> read_stages(const Stage& stage, const config::CaseConfi
   return earlier;
 }
 
-// Before stage `name` runs: every earlier stage it reads that ran in this
-// folder must have merged its outputs from the jobs this case plans (else a
-// ConfigError names it and the command that redoes it: a report never mixes
-// two runs), and a damaged merged output is rebuilt from the stage's jobs
-// when they are all done (not from an array task: its siblings would race).
+// What stage `name` finds in an earlier stage `stage` that it reads and that
+// ran in this folder: merged outputs made from jobs this case no longer plans
+// (`stale`, a sentence), or a damaged merged output while every job of it is
+// done (`damaged`: finalize rebuilds it).
+struct EarlierStage {
+  std::string stage;
+  Plan plan;
+  std::string stale, damaged;
+};
+
+// Every earlier stage that stage `name` reads (see EarlierStage) with a
+// problem, in pipeline order.
+std::vector<EarlierStage> earlier_stage_problems(const std::vector<std::unique_ptr<Stage>>& stages,
+                                                 const std::string& name,
+                                                 const config::CaseConfig& cfg,
+                                                 const Invocation& inv, engine::Runner& runner,
+                                                 Progress& progress) {
+  const fs::path run_dir = inv.opts.output;
+  std::vector<EarlierStage> found;
+  for (const auto& e : read_stages(find_stage(stages, name), cfg)) {
+    engine::throw_if_interrupted();
+    const Stage& earlier = find_stage(stages, e);
+    const StageContext ctx{cfg, inv.opts, run_dir, run_dir / e, runner, progress};
+    if (!fs::is_directory(ctx.stage_dir)) continue;
+    EarlierStage p{e, earlier.plan(ctx), "", ""};
+    if (const std::string why = stage_stamp_mismatch(ctx.stage_dir, p.plan); !why.empty()) {
+      p.stale = fmt::format(
+          "stage {} reads the results of stage {}, but {}: {}. Rerun it first: orchestrate --case "
+          "{} --stage {}-{} --output {} (with --force if the folder is said to hold other values)",
+          name, e, ctx.stage_dir.string(), why, cfg.file.string(), e, name, run_dir.string());
+    } else if (const std::string damaged = earlier.damaged_merged_outputs(ctx, p.plan.jobs);
+               !damaged.empty() && !p.plan.jobs.empty()) {
+      const auto rows = decide_all(earlier, ctx, jobs::JobStore(ctx.stage_dir), p.plan, false);
+      // Not all done: not merged yet, and the stage that reads it names what it misses.
+      if (std::all_of(rows.begin(), rows.end(),
+                      [](const JobRow& r) { return r.verdict.decision == jobs::Decision::Skip; }))
+        p.damaged = fmt::format("from its {} done job(s): {}", rows.size(), damaged);
+    }
+    if (!p.stale.empty() || !p.damaged.empty()) found.push_back(std::move(p));
+  }
+  return found;
+}
+
+// Before stage `name` runs: an earlier stage it reads whose merged outputs
+// come from other jobs stops the command (a report never mixes two runs); a
+// damaged merged output is rebuilt from the stage's done jobs (not from an
+// array task: its siblings would race).
 void check_read_stages(const std::vector<std::unique_ptr<Stage>>& stages, const std::string& name,
                        const config::CaseConfig& cfg, const Invocation& inv, engine::Runner& runner,
                        Progress& progress) {
-  const fs::path run_dir = inv.opts.output;
-  for (const auto& e : read_stages(find_stage(stages, name), cfg)) {
-    engine::throw_if_interrupted();
-    Stage& earlier = find_stage(stages, e);
-    StageContext ctx{cfg, inv.opts, run_dir, run_dir / e, runner, progress};
-    if (!fs::is_directory(ctx.stage_dir)) continue;
-    const Plan plan = earlier.plan(ctx);
-    if (const std::string why = stage_stamp_mismatch(ctx.stage_dir, plan); !why.empty())
-      throw config::ConfigError(fmt::format(
-          "stage {} reads the results of stage {}, but {}: {}. Rerun it first: orchestrate --case "
-          "{} --stage "
-          "{}-{} --output {} (with --force if the folder is said to hold other values)",
-          name, e, ctx.stage_dir.string(), why, cfg.file.string(), e, name, run_dir.string()));
-    const std::string damaged = earlier.damaged_merged_outputs(ctx, plan.jobs);
-    if (damaged.empty() || inv.task || plan.jobs.empty()) continue;
-    const jobs::JobStore store(ctx.stage_dir);
-    const auto rows = decide_all(earlier, ctx, store, plan, false);
-    if (!std::all_of(rows.begin(), rows.end(),
-                     [](const JobRow& r) { return r.verdict.decision == jobs::Decision::Skip; }))
-      continue;  // not merged yet: the stage that reads it names what it misses
-    progress.info(fmt::format("[{}] rebuild the merged outputs from its {} done job(s): {}", e,
-                              rows.size(), damaged));
-    earlier.finalize(ctx, plan.jobs);
-    write_stage_stamp(ctx.stage_dir, plan);
-    if (const std::string still = earlier.damaged_merged_outputs(ctx, plan.jobs); !still.empty())
-      throw std::runtime_error(fmt::format(
-          "stage {}: its merged outputs, rebuilt from its jobs, are still damaged: {}", e, still));
+  for (const auto& p : earlier_stage_problems(stages, name, cfg, inv, runner, progress)) {
+    if (!p.stale.empty()) throw config::ConfigError(p.stale);
+    if (inv.task) continue;
+    Stage& earlier = find_stage(stages, p.stage);
+    StageContext ctx{cfg, inv.opts, inv.opts.output, inv.opts.output / p.stage, runner, progress};
+    progress.info(fmt::format("[{}] rebuild the merged outputs {}", p.stage, p.damaged));
+    earlier.finalize(ctx, p.plan.jobs);
+    write_stage_stamp(ctx.stage_dir, p.plan);
+    if (const std::string still = earlier.damaged_merged_outputs(ctx, p.plan.jobs); !still.empty())
+      throw std::runtime_error(
+          fmt::format("stage {}: its merged outputs, rebuilt from its jobs, are still damaged: {}",
+                      p.stage, still));
   }
+}
+
+// --dry-run: what check_read_stages would do before stage `name`.
+void print_read_stages(std::ostream& out, const std::vector<std::unique_ptr<Stage>>& stages,
+                       const std::string& name, const config::CaseConfig& cfg,
+                       const Invocation& inv, engine::Runner& runner, Progress& progress) {
+  for (const auto& p : earlier_stage_problems(stages, name, cfg, inv, runner, progress))
+    out << (p.stale.empty() ? fmt::format("  note: would first rebuild the merged outputs of stage "
+                                          "{} {}\n",
+                                          p.stage, p.damaged)
+                            : "  note: a run would stop here: " + p.stale + "\n");
 }
 
 }  // namespace
@@ -464,6 +502,7 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
     }
     if (inv.dry_run) {
       print_plan(out, inv, stage, plan, rows);
+      print_read_stages(out, stages, name, cfg, inv, runner, progress);
       continue;
     }
     if (inv.merge_only) {
