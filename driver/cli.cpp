@@ -50,8 +50,11 @@ Examples:
 
 A rerun of the same command resumes: done jobs whose inputs did not change are
 skipped; failed, interrupted and changed ones are rerun (--force redoes all).
-Exit status: 0 ok, 1 a job failed, 2 bad input, 3 stage not implemented yet,
-128+N interrupted by signal N.
+A run folder holds one case with one set of values, written by one command at
+a time: another case, or this case with other values, is refused (--force
+takes the folder over).
+Exit status: 0 ok, 1 a job failed (or the run folder is in use), 2 bad input,
+3 stage not implemented yet, 128+N interrupted by signal N.
 )";
 
 // A CLI11 check: a plain decimal number (no hex, inf or nan) in [lo, hi],
