@@ -298,7 +298,8 @@ std::string command_text(int argc, char** argv) {
 
 // orchestrate impact: the case with --ore and --elements applied, one impact
 // into --output (--check: validate only; --dry-run: say what would be done).
-int impact_command(const CliArgs& a, const std::string& command, std::ostream& out) {
+int impact_command(const CliArgs& a, const std::string& command, std::ostream& out,
+                   std::ostream& err) {
   std::vector<std::pair<std::string, std::string>> ov;
   if (!a.imp_ore.empty()) ov.push_back({"ore.card", "'" + a.imp_ore + "'"});
   if (a.imp_elements > 0) ov.push_back({"lump.n_elements", std::to_string(a.imp_elements)});
@@ -322,6 +323,7 @@ int impact_command(const CliArgs& a, const std::string& command, std::ostream& o
   }
   std::optional<jobs::RunLock> lock;
   if (!a.dry_run) lock.emplace(opts.output, jobs::RunLock::Mode::Exclusive, command);
+  if (lock && !lock->warning().empty()) err << "warning: " << lock->warning() << "\n";
   return run_single_impact(cfg, opts, a.imp_velocity, a.imp_angle, a.imp_repeat, a.dry_run, out);
 }
 
@@ -407,6 +409,7 @@ int stage_command(const config::CaseConfig& cfg, const CliArgs& a, const std::st
     lock.emplace(inv.opts.output,
                  a.task >= 0 ? jobs::RunLock::Mode::Shared : jobs::RunLock::Mode::Exclusive,
                  command);
+  if (lock && !lock->warning().empty()) err << "warning: " << lock->warning() << "\n";
   return run_pipeline(cfg, inv, out);
 }
 
@@ -476,7 +479,7 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
       out << config::schema_markdown();
       return 0;
     }
-    if (*impact) return impact_command(a, command, out);
+    if (*impact) return impact_command(a, command, out, err);
     if (*compare) return compare_command(a, out);
     const auto cfg = config::load_case(a.case_file, project_dir());
     if (*hpc) return hpc_command(cfg, a, out);

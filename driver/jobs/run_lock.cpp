@@ -81,6 +81,14 @@ RunLock::RunLock(const fs::path& run_dir, Mode mode, const std::string& command)
     const std::string holders = err == EWOULDBLOCK ? holders_text(read_all(fd_)) : "";
     close(fd_);
     fd_ = -1;
+    if (err == ENOLCK || err == EOPNOTSUPP) {
+      // A file system without locks (NFS without lockd): run, but say so.
+      warning_ = fmt::format(
+          "{}: the file system cannot lock the run folder ({}), so nothing keeps a second "
+          "command out of it; run one orchestrate at a time on it",
+          f.string(), strerror(err));
+      return;
+    }
     if (err != EWOULDBLOCK)
       throw std::runtime_error(
           fmt::format("cannot lock the run folder ({}): {}", f.string(), strerror(err)));

@@ -29,9 +29,13 @@ class RunLock {
   RunLock& operator=(const RunLock&) = delete;
 
   static std::filesystem::path file(const std::filesystem::path& run_dir);
+  // Not empty when the file system has no locks: the command runs unlocked,
+  // and this says so (to print as a warning).
+  const std::string& warning() const { return warning_; }
 
  private:
   int fd_ = -1;
+  std::string warning_;
 };
 
 }  // namespace mill::jobs
