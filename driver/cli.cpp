@@ -4,10 +4,13 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <memory>
+#include <optional>
 #include <regex>
 
 #include "compare.h"
@@ -15,7 +18,9 @@
 #include "config/schema.h"
 #include "engine/runner.h"
 #include "hpc.h"
+#include "jobs/run_lock.h"
 #include "pipeline.h"
+#include "run_folder.h"
 #include "stages/stage.h"
 
 namespace mill {
@@ -46,8 +51,11 @@ Examples:
 
 A rerun of the same command resumes: done jobs whose inputs did not change are
 skipped; failed, interrupted and changed ones are rerun (--force redoes all).
-Exit status: 0 ok, 1 a job failed, 2 bad input, 3 stage not implemented yet,
-128+N interrupted by signal N.
+A run folder holds one case with one set of values, written by one command at
+a time: another case, or this case with other values, is refused (--force
+takes the folder over).
+Exit status: 0 ok, 1 a job failed (or the run folder is in use), 2 bad input,
+3 stage not implemented yet, 128+N interrupted by signal N.
 )";
 
 // A CLI11 check: a plain decimal number (no hex, inf or nan) in [lo, hi],
@@ -101,6 +109,74 @@ void check_output_path(const fs::path& out) {
     }
     if (p == p.parent_path()) return;
   }
+}
+
+// The commands of orchestrate, for the table of which option each takes.
+enum Command { kStages, kImpact, kCompare, kHpc, kCommands };
+const char* const kCommandName[kCommands] = {"a stage run", "orchestrate impact",
+                                             "orchestrate compare", "orchestrate hpc"};
+
+// Which command takes which option of the main command (which subcommands
+// reach through CLI11's fallthrough), and what the option is for. An option
+// given to a command that does not take it is refused, never ignored.
+struct OptionUse {
+  const char* name;
+  bool takes[kCommands];  // stages, impact, compare, hpc
+  const char* what;
+};
+const OptionUse kOptionUse[] = {
+    {"--case", {true, true, false, true}, "names the case file"},
+    {"--stage", {true, false, false, true}, "chooses the stages"},
+    {"--output", {true, true, true, true}, "names the output folder"},
+    {"--np", {true, true, false, true}, "sets the MPI ranks of an engine run"},
+    {"--jobs", {true, false, false, false}, "sets how many engine runs go at once"},
+    {"--dry-run", {true, true, true, false}, "shows what would be done"},
+    {"--list-tasks", {true, false, false, false}, "lists a stage's jobs"},
+    {"--task", {true, false, false, false}, "runs one job of a stage"},
+    {"--merge-only", {true, false, false, false}, "merges a stage whose jobs are done"},
+    {"--force", {true, true, false, true}, "redoes done work or takes a run folder over"},
+    {"--check", {true, true, false, false}, "validates the case"},
+    {"--print-schema", {true, false, false, false}, "prints the case keys"},
+};
+
+// The options given on the command line (by their long name).
+std::vector<std::string> given_options(const CLI::App& app) {
+  std::vector<std::string> given;
+  for (const auto& u : kOptionUse)
+    if (app.get_option(u.name)->count() > 0) given.push_back(u.name);
+  return given;
+}
+
+// Refuses an option that `cmd` does not take, and options that contradict
+// each other (each would ignore the other): ConfigError naming both.
+void check_option_use(const CLI::App& app, Command cmd) {
+  const auto given = given_options(app);
+  for (const auto& u : kOptionUse)
+    if (!u.takes[cmd] && app.get_option(u.name)->count() > 0)
+      throw config::ConfigError(
+          fmt::format("{}: not an option of {} (in a stage run it {}); drop it", u.name,
+                      kCommandName[cmd], u.what));
+  auto has = [&](const char* o) { return std::find(given.begin(), given.end(), o) != given.end(); };
+  // At most one of the modes that replace running.
+  const char* modes[] = {"--print-schema", "--check", "--dry-run", "--list-tasks", "--merge-only"};
+  std::vector<std::string> on;
+  for (const char* m : modes)
+    if (has(m)) on.push_back(m);
+  if (on.size() > 1)
+    throw config::ConfigError(
+        fmt::format("{}: cannot go with {}: each does something else instead of running; "
+                    "give one of them",
+                    on[1], on[0]));
+  // The modes that stop before any stage take only what they use.
+  if (cmd == kStages && (has("--print-schema") || has("--check")))
+    for (const auto& g : given) {
+      const bool used = g == on[0] || (on[0] == std::string("--check") && g == "--case");
+      if (!used)
+        throw config::ConfigError(fmt::format(
+            "{}: {} {} and runs nothing, so {} would be ignored; drop it", g, on[0],
+            on[0] == std::string("--check") ? "validates the case file" : "prints the case keys",
+            g));
+    }
 }
 
 // Everything the command line sets, with its defaults.
@@ -220,9 +296,19 @@ CLI::App* add_compare_command(CLI::App& app, CliArgs& a) {
   return compare;
 }
 
+// The command line as one string, for the run-folder lock's record.
+std::string command_text(int argc, char** argv) {
+  std::string s;
+  for (int i = 0; i < argc && s.size() < 200; ++i) s += (i ? " " : "") + std::string(argv[i]);
+  for (auto& c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  return s.substr(0, 200);
+}
+
 // orchestrate impact: the case with --ore and --elements applied, one impact
-// into --output.
-int impact_command(const CliArgs& a, std::ostream& out) {
+// into --output (--check: validate only; --dry-run: say what would be done).
+int impact_command(const CliArgs& a, const std::string& command, std::ostream& out,
+                   std::ostream& err) {
   std::vector<std::pair<std::string, std::string>> ov;
   if (!a.imp_ore.empty()) ov.push_back({"ore.card", "'" + a.imp_ore + "'"});
   if (a.imp_elements > 0) ov.push_back({"lump.n_elements", std::to_string(a.imp_elements)});
@@ -234,18 +320,44 @@ int impact_command(const CliArgs& a, std::ostream& out) {
   RunOptions opts;
   opts.output = fs::absolute(out_dir);
   check_output_path(opts.output);
-  check_run_folder(cfg, opts.output, a.force);
+  check_run_folder(cfg, opts.output, a.force, FolderKind::Impact);
   opts.force = a.force;
   opts.np = a.np > 0 ? a.np : static_cast<int>(cfg.doc.integer("resources.np"));
-  return run_single_impact(cfg, opts, a.imp_velocity, a.imp_angle, a.imp_repeat, out);
+  if (a.check) {
+    out << fmt::format(
+        "{}: case '{}' is valid for an impact at {:g} m/s, {:g} deg into {}; ore card {} ({})\n",
+        cfg.file.string(), cfg.name, a.imp_velocity, a.imp_angle, opts.output.string(),
+        cfg.ore_file.string(), cfg.ore.str("name"));
+    return 0;
+  }
+  std::optional<jobs::RunLock> lock;
+  if (!a.dry_run) lock.emplace(opts.output, jobs::RunLock::Mode::Exclusive, command);
+  if (lock && !lock->warning().empty()) err << "warning: " << lock->warning() << "\n";
+  return run_single_impact(cfg, opts, a.imp_velocity, a.imp_angle, a.imp_repeat, a.dry_run, out);
 }
 
-// orchestrate compare: the page of the runs given.
+// orchestrate compare: the page of the runs given, into a folder of its own
+// (never inside a run folder: the page would take the place of its report).
 int compare_command(const CliArgs& a, std::ostream& out) {
   CompareOptions co;
   for (const auto& r : a.compare_runs) co.runs.emplace_back(r);
   co.output = fs::absolute(a.output.empty() ? fs::path("runs") / "compare" : fs::path(a.output));
   co.project_dir = project_dir();
+  check_output_path(co.output);
+  if (const fs::path owner = owning_run_folder(co.output); !owner.empty())
+    throw config::ConfigError(fmt::format(
+        "compare: --output {}: inside the run folder {} (it holds resolved_case.json), which "
+        "belongs to "
+        "its case and stages; give compare a folder of its own, e.g. --output runs/compare",
+        co.output.string(), owner.string()));
+  if (a.dry_run) {
+    check_compare_runs(co.runs);
+    out << fmt::format(
+        "compare: {} finished runs; would write {} and {} (dry run: nothing written)\n",
+        co.runs.size(), (co.output / "index.html").string(),
+        (co.output / "figures" / "compare_passing.png").string());
+    return 0;
+  }
   out << write_compare(co);
   return 0;
 }
@@ -273,8 +385,8 @@ int hpc_command(const config::CaseConfig& cfg, CliArgs& a, std::ostream& out) {
 }
 
 // The main command: run (or plan, list, merge) the stages given.
-int stage_command(const config::CaseConfig& cfg, const CliArgs& a, std::ostream& out,
-                  std::ostream& err) {
+int stage_command(const config::CaseConfig& cfg, const CliArgs& a, const std::string& command,
+                  std::ostream& out, std::ostream& err) {
   if (a.stage.empty()) {
     err << "error: --stage: which stage? expected one of flow, sample, transport, calibrate, "
            "breakage, report, all\n"
@@ -287,7 +399,10 @@ int stage_command(const config::CaseConfig& cfg, const CliArgs& a, std::ostream&
   inv.opts.output =
       fs::absolute(a.output.empty() ? fs::path("runs") / cfg.name : fs::path(a.output));
   check_output_path(inv.opts.output);
-  check_run_folder(cfg, inv.opts.output, a.force);
+  if (const std::string warning = check_run_folder(cfg, inv.opts.output, a.force,
+                                                   FolderKind::Stages, a.dry_run || a.list_tasks);
+      !warning.empty())
+    err << "warning: " << warning << "\n";
   inv.opts.np = a.np > 0 ? a.np : static_cast<int>(cfg.doc.integer("resources.np"));
   inv.opts.jobs = a.jobs > 0 ? a.jobs : static_cast<int>(cfg.doc.integer("resources.jobs"));
   inv.opts.force = a.force;
@@ -297,6 +412,20 @@ int stage_command(const config::CaseConfig& cfg, const CliArgs& a, std::ostream&
   inv.list_tasks = a.list_tasks;
   inv.merge_only = a.merge_only;
   if (a.task >= 0) inv.task = a.task;
+  // One writer per stage at a time; the tasks of a scheduler array share
+  // their stage.
+  std::vector<std::unique_ptr<jobs::RunLock>> locks;
+  if (!a.dry_run && !a.list_tasks)
+    for (const std::string& stage : inv.stages) {
+      locks.push_back(std::make_unique<jobs::RunLock>(
+          inv.opts.output,
+          a.task >= 0 ? jobs::RunLock::Mode::Shared : jobs::RunLock::Mode::Exclusive, command,
+          stage));
+      if (!locks.back()->warning().empty()) {
+        err << "warning: " << locks.back()->warning() << "\n";
+        break;  // the same file system for every stage's lock
+      }
+    }
   return run_pipeline(cfg, inv, out);
 }
 
@@ -310,6 +439,9 @@ int error_status(std::ostream& err) {
   } catch (const NotImplemented& e) {
     err << "error: " << e.what() << "\n";
     return kExitNotImplemented;
+  } catch (const jobs::RunFolderBusy& e) {
+    err << "error: " << e.what() << "\n";
+    return kExitFailed;
   } catch (const MissingInput& e) {
     err << "error: " << e.what() << "\n";
     return kExitFailed;
@@ -356,12 +488,14 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
 
-  if (a.print_schema) {
-    out << config::schema_markdown();
-    return 0;
-  }
+  const std::string command = command_text(argc, argv);
   try {
-    if (*impact) return impact_command(a, out);
+    check_option_use(app, *impact ? kImpact : *compare ? kCompare : *hpc ? kHpc : kStages);
+    if (a.print_schema) {
+      out << config::schema_markdown();
+      return 0;
+    }
+    if (*impact) return impact_command(a, command, out, err);
     if (*compare) return compare_command(a, out);
     const auto cfg = config::load_case(a.case_file, project_dir());
     if (*hpc) return hpc_command(cfg, a, out);
@@ -370,7 +504,7 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
                          cfg.ore_file.string(), cfg.ore.str("name"));
       return 0;
     }
-    return stage_command(cfg, a, out, err);
+    return stage_command(cfg, a, command, out, err);
   } catch (...) {
     return error_status(err);
   }

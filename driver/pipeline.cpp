@@ -3,7 +3,6 @@
 
 #include <fmt/format.h>
 #include <unistd.h>
-#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <atomic>
@@ -19,6 +18,7 @@
 #include "engine/runner.h"
 #include "jobs/job_store.h"
 #include "progress.h"
+#include "run_folder.h"
 #include "stages/breakage/impact_runs.h"
 
 namespace mill {
@@ -72,6 +72,7 @@ std::vector<JobRow> decide_all(const Stage& stage, const StageContext& ctx,
                                const jobs::JobStore& store, const Plan& plan, bool force) {
   std::vector<JobRow> rows;
   for (const auto& j : plan.jobs) {
+    engine::throw_if_interrupted();
     jobs::Verdict v = store.decide(j.label, j.inputs, force);
     if (v.decision == jobs::Decision::Skip)
       if (const std::string why = stage.damaged_outputs(ctx, j); !why.empty())
@@ -86,6 +87,7 @@ std::vector<JobRow> decide_all(const Stage& stage, const StageContext& ctx,
 void check_unique_labels(const std::string& stage, const Plan& plan) {
   std::map<std::string, size_t> seen;
   for (size_t i = 0; i < plan.jobs.size(); ++i) {
+    engine::throw_if_interrupted();
     const auto [it, fresh] = seen.emplace(plan.jobs[i].label, i);
     if (!fresh)
       throw config::ConfigError(
@@ -102,26 +104,6 @@ std::string verdict_tag(const jobs::Verdict& v) {
   if (v.decision == jobs::Decision::Skip) return "done";
   if (v.decision == jobs::Decision::Busy) return "busy";
   return "todo";
-}
-
-// Keep a copy of what was run next to the results (provenance).
-void write_provenance(const config::CaseConfig& cfg, const fs::path& run_dir) {
-  fs::create_directories(run_dir);
-  auto copy = [&](const fs::path& from, const fs::path& to) {
-    std::ifstream in(from);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    jobs::atomic_write(to, text);
-  };
-  copy(cfg.file, run_dir / "case.yaml");
-  copy(cfg.ore_file, run_dir / "ore.yaml");
-  nlohmann::json j = {{"case_file", cfg.file.string()},
-                      {"ore_card", cfg.ore_file.string()},
-                      {"case", cfg.doc.to_json()},
-                      {"ore", cfg.ore.to_json()},
-                      {"orchestrate_version", MILL_VERSION}};
-  j["case_name"] = cfg.name;
-  j["outside_plausible_range"] = config::outliers(cfg);
-  jobs::atomic_write(run_dir / "resolved_case.json", j.dump(2) + "\n");
 }
 
 // Run one job with its STATUS bookkeeping. Returns "" on success, else the reason.
@@ -163,10 +145,17 @@ std::string not_done_text(const jobs::JobStore& store, const JobRow& r) {
       why = "not run: no STATUS (its task did not start, or failed before the job did)";
       break;
     case jobs::State::Running:
-      why = fmt::format(
-          "did not finish: STATUS still says running as pid {} on {} (killed, e.g. at the time "
-          "limit?)",
-          s.pid, s.host);
+      why = s.host == jobs::JobStore::hostname() &&
+                    !jobs::JobStore::process_alive(s.pid, s.start_ticks)
+                ? fmt::format(
+                      "did not finish: STATUS says running as pid {} on {}, which is gone (stale: "
+                      "killed, e.g. at the time limit?)",
+                      s.pid, s.host)
+                : fmt::format(
+                      "did not finish: STATUS still says running as pid {} on {} (killed, e.g. at "
+                      "the time "
+                      "limit?)",
+                      s.pid, s.host);
       break;
     case jobs::State::Failed:
       why = "failed: " + s.reason;
@@ -209,18 +198,28 @@ void check_task_index(const Invocation& inv, const std::string& name, const Plan
                           plan.jobs.size() == 1 ? "" : "s", *inv.task));
 }
 
-// --list-tasks: one job per line (index, label, state, summary).
-void print_tasks(std::ostream& out, const std::string& name, const Plan& plan,
-                 const std::vector<JobRow>& rows) {
-  for (size_t i = 0; i < rows.size(); ++i)
+// The indices of the jobs an invocation covers: all, or job --task.
+std::vector<size_t> covered(const Invocation& inv, size_t n) {
+  if (inv.task) return {static_cast<size_t>(*inv.task)};
+  std::vector<size_t> all(n);
+  for (size_t i = 0; i < n; ++i) all[i] = i;
+  return all;
+}
+
+// --list-tasks: one job per line (index, label, state, summary); only job
+// --task with --task.
+void print_tasks(std::ostream& out, const Invocation& inv, const std::string& name,
+                 const Plan& plan, const std::vector<JobRow>& rows) {
+  for (const size_t i : covered(inv, rows.size()))
     out << fmt::format("{}\t{}\t{}\t{}\n", i, rows[i].spec.label, verdict_tag(rows[i].verdict),
                        rows[i].spec.summary);
   if (rows.empty() && !plan.note.empty())
     out << "# " << name << ": no tasks yet: " << plan.note << "\n";
 }
 
-// --dry-run: the stage, its jobs, which are done and their ids.
-void print_plan(std::ostream& out, const Stage& stage, const Plan& plan,
+// --dry-run: the stage, its jobs, which are done and their ids (only job
+// --task with --task, which runs no merge).
+void print_plan(std::ostream& out, const Invocation& inv, const Stage& stage, const Plan& plan,
                 const std::vector<JobRow>& rows) {
   const int n_done = static_cast<int>(std::count_if(rows.begin(), rows.end(), [](const JobRow& r) {
     return r.verdict.decision == jobs::Decision::Skip;
@@ -229,7 +228,10 @@ void print_plan(std::ostream& out, const Stage& stage, const Plan& plan,
                      stage.description(), stage.implemented() ? "" : " [not implemented yet]",
                      rows.size(), rows.size() == 1 ? "" : "s", n_done, rows.size() - n_done);
   if (!plan.note.empty()) out << "  note: " << plan.note << "\n";
-  for (size_t i = 0; i < rows.size(); ++i)
+  if (inv.task)
+    out << fmt::format("  --task {}: only this job would run, and the stage would not be merged\n",
+                       *inv.task);
+  for (const size_t i : covered(inv, rows.size()))
     out << fmt::format("  [{}] {:>3} {:<22} {} ({}, id {})\n", verdict_tag(rows[i].verdict), i,
                        rows[i].spec.label, rows[i].spec.summary, rows[i].verdict.why,
                        jobs::job_id(rows[i].spec.inputs));
@@ -265,6 +267,7 @@ int merge_stage(const StagePass& p, std::ostream& out, const std::function<void(
   }
   before_merge();
   p.stage.finalize(p.ctx, p.plan.jobs);
+  if (!p.plan.jobs.empty()) write_stage_stamp(p.ctx.stage_dir, p.plan);
   out << fmt::format("stage '{}': all {} job(s) done; merged.\n", name, p.rows.size());
   return kExitOk;
 }
@@ -361,8 +364,97 @@ int run_stage(const StagePass& p, const Invocation& inv, std::ostream& out) {
   }
   if (!res.busy.empty()) return kExitFailed;
   // A single array task does not merge; the follow-up (whole stage) run does.
-  if (!inv.task) p.stage.finalize(p.ctx, p.plan.jobs);
+  if (!inv.task) {
+    p.stage.finalize(p.ctx, p.plan.jobs);
+    if (!p.plan.jobs.empty()) write_stage_stamp(p.ctx.stage_dir, p.plan);
+  }
   return kExitOk;
+}
+
+// The earlier stages whose merged outputs `stage` reads: the report reads
+// every earlier stage; the others name theirs.
+std::vector<std::string> read_stages(const Stage& stage, const config::CaseConfig& cfg) {
+  if (stage.name() != "report") return stage.reads(cfg);
+  std::vector<std::string> earlier;
+  for (const auto& n : stage_names())
+    if (n != "report") earlier.push_back(n);
+  return earlier;
+}
+
+// What stage `name` finds in an earlier stage `stage` that it reads and that
+// ran in this folder: merged outputs made from jobs this case no longer plans
+// (`stale`, a sentence), or a damaged merged output while every job of it is
+// done (`damaged`: finalize rebuilds it).
+struct EarlierStage {
+  std::string stage;
+  Plan plan;
+  std::string stale, damaged;
+};
+
+// Every earlier stage that stage `name` reads (see EarlierStage) with a
+// problem, in pipeline order.
+std::vector<EarlierStage> earlier_stage_problems(const std::vector<std::unique_ptr<Stage>>& stages,
+                                                 const std::string& name,
+                                                 const config::CaseConfig& cfg,
+                                                 const Invocation& inv, engine::Runner& runner,
+                                                 Progress& progress) {
+  const fs::path run_dir = inv.opts.output;
+  std::vector<EarlierStage> found;
+  for (const auto& e : read_stages(find_stage(stages, name), cfg)) {
+    engine::throw_if_interrupted();
+    const Stage& earlier = find_stage(stages, e);
+    const StageContext ctx{cfg, inv.opts, run_dir, run_dir / e, runner, progress};
+    if (!fs::is_directory(ctx.stage_dir)) continue;
+    EarlierStage p{e, earlier.plan(ctx), "", ""};
+    if (const std::string why = stage_stamp_mismatch(ctx.stage_dir, p.plan); !why.empty()) {
+      p.stale = fmt::format(
+          "stage {} reads the results of stage {}, but {}: {}. Rerun it first: orchestrate --case "
+          "{} --stage {}-{} --output {} (with --force if the folder is said to hold other values)",
+          name, e, ctx.stage_dir.string(), why, cfg.file.string(), e, name, run_dir.string());
+    } else if (const std::string damaged = earlier.damaged_merged_outputs(ctx, p.plan.jobs);
+               !damaged.empty() && !p.plan.jobs.empty()) {
+      const auto rows = decide_all(earlier, ctx, jobs::JobStore(ctx.stage_dir), p.plan, false);
+      // Not all done: not merged yet, and the stage that reads it names what it misses.
+      if (std::all_of(rows.begin(), rows.end(),
+                      [](const JobRow& r) { return r.verdict.decision == jobs::Decision::Skip; }))
+        p.damaged = fmt::format("from its {} done job(s): {}", rows.size(), damaged);
+    }
+    if (!p.stale.empty() || !p.damaged.empty()) found.push_back(std::move(p));
+  }
+  return found;
+}
+
+// Before stage `name` runs: an earlier stage it reads whose merged outputs
+// come from other jobs stops the command (a report never mixes two runs); a
+// damaged merged output is rebuilt from the stage's done jobs (not from an
+// array task: its siblings would race).
+void check_read_stages(const std::vector<std::unique_ptr<Stage>>& stages, const std::string& name,
+                       const config::CaseConfig& cfg, const Invocation& inv, engine::Runner& runner,
+                       Progress& progress) {
+  for (const auto& p : earlier_stage_problems(stages, name, cfg, inv, runner, progress)) {
+    if (!p.stale.empty()) throw config::ConfigError(p.stale);
+    if (inv.task) continue;
+    Stage& earlier = find_stage(stages, p.stage);
+    StageContext ctx{cfg, inv.opts, inv.opts.output, inv.opts.output / p.stage, runner, progress};
+    progress.info(fmt::format("[{}] rebuild the merged outputs {}", p.stage, p.damaged));
+    earlier.finalize(ctx, p.plan.jobs);
+    write_stage_stamp(ctx.stage_dir, p.plan);
+    if (const std::string still = earlier.damaged_merged_outputs(ctx, p.plan.jobs); !still.empty())
+      throw std::runtime_error(
+          fmt::format("stage {}: its merged outputs, rebuilt from its jobs, are still damaged: {}",
+                      p.stage, still));
+  }
+}
+
+// --dry-run: what check_read_stages would do before stage `name`.
+void print_read_stages(std::ostream& out, const std::vector<std::unique_ptr<Stage>>& stages,
+                       const std::string& name, const config::CaseConfig& cfg,
+                       const Invocation& inv, engine::Runner& runner, Progress& progress) {
+  for (const auto& p : earlier_stage_problems(stages, name, cfg, inv, runner, progress))
+    out << (p.stale.empty() ? fmt::format("  note: would first rebuild the merged outputs of stage "
+                                          "{} {}\n",
+                                          p.stage, p.damaged)
+                            : "  note: a run would stop here: " + p.stale + "\n");
 }
 
 }  // namespace
@@ -376,20 +468,26 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
   bool provenance_written = false;
   // A copy of what was run, written once before the first job or merge.
   const std::function<void()> provenance = [&]() {
-    if (!provenance_written) write_provenance(cfg, run_dir), provenance_written = true;
+    if (!provenance_written)
+      write_provenance(cfg, run_dir, FolderKind::Stages), provenance_written = true;
   };
 
   if (inv.dry_run)
-    out << fmt::format("plan for case '{}' ({}), output {}\n", cfg.name, cfg.file.string(),
-                       run_dir.string());
+    out << fmt::format(
+        "plan for case '{}' ({}), output {}; {} engine run(s) at once, {} MPI rank(s) each\n",
+        cfg.name, cfg.file.string(), run_dir.string(), inv.opts.jobs, inv.opts.np);
   // Every stage's plan as far as it is known now, before any stage runs: a
   // label clash in a late stage must not surface after hours of earlier ones.
   for (const auto& name : inv.stages) {
+    engine::throw_if_interrupted();
     StageContext ctx{cfg, inv.opts, run_dir, run_dir / name, runner, progress};
     check_unique_labels(name, find_stage(stages, name).plan(ctx));
   }
 
   for (const auto& name : inv.stages) {
+    engine::throw_if_interrupted();
+    if (!inv.dry_run && !inv.list_tasks)
+      check_read_stages(stages, name, cfg, inv, runner, progress);
     Stage& stage = find_stage(stages, name);
     StageContext ctx{cfg, inv.opts, run_dir, run_dir / name, runner, progress};
     const jobs::JobStore store(ctx.stage_dir);
@@ -399,11 +497,12 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
     const auto rows = decide_all(stage, ctx, store, plan, inv.opts.force);
     const StagePass pass{stage, ctx, store, plan, rows};
     if (inv.list_tasks) {
-      print_tasks(out, name, plan, rows);
+      print_tasks(out, inv, name, plan, rows);
       continue;
     }
     if (inv.dry_run) {
-      print_plan(out, stage, plan, rows);
+      print_plan(out, inv, stage, plan, rows);
+      print_read_stages(out, stages, name, cfg, inv, runner, progress);
       continue;
     }
     if (inv.merge_only) {
@@ -422,43 +521,6 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
   return kExitOk;
 }
 
-void check_run_folder(const config::CaseConfig& cfg, const fs::path& run_dir, bool force) {
-  if (force) return;
-  const fs::path resolved = run_dir / "resolved_case.json", copy = run_dir / "case.yaml";
-  std::string owner, owner_file;
-  std::error_code ec;
-  if (fs::exists(resolved, ec)) {
-    std::ifstream in(resolved);
-    const auto j = nlohmann::json::parse(in, nullptr, false);
-    if (!j.is_object())
-      throw config::ConfigError(
-          fmt::format("--output {}: {} is damaged (not a JSON object), so the folder's case is "
-                      "unknown; use another --output, or --force to take the folder over",
-                      run_dir.string(), resolved.string()));
-    owner_file = j.value("case_file", std::string());
-    if (j.contains("case_name") && j["case_name"].is_string())
-      owner = j["case_name"].get<std::string>();
-    else if (j.contains("case") && j["case"].is_object() && j["case"].contains("name") &&
-             j["case"]["name"].is_string())
-      owner = j["case"]["name"].get<std::string>();
-    else if (!owner_file.empty())
-      owner = fs::path(owner_file).stem().string();
-  } else if (fs::exists(copy, ec)) {
-    try {
-      const YAML::Node n = YAML::LoadFile(copy.string());
-      if (n.IsMap() && n["name"] && n["name"].IsScalar()) owner = n["name"].Scalar();
-    } catch (const YAML::Exception&) {
-    }
-  }
-  if (owner.empty() || owner == cfg.name) return;
-  throw config::ConfigError(
-      fmt::format("--output {}: the run folder belongs to case '{}'{}; this is case '{}' ({}): use "
-                  "another --output (the default "
-                  "is runs/{}), or --force to take the folder over (every job is then redone)",
-                  run_dir.string(), owner, owner_file.empty() ? "" : " (" + owner_file + ")",
-                  cfg.name, cfg.file.string(), cfg.name));
-}
-
 int count_tasks(const config::CaseConfig& cfg, const Invocation& inv) {
   auto stages = make_stages();
   engine::Runner runner;
@@ -473,8 +535,42 @@ int count_tasks(const config::CaseConfig& cfg, const Invocation& inv) {
   return 0;
 }
 
+namespace {
+
+// A finished impact in the folder that was made with other inputs is
+// replaced only with --force: its result would be lost.
+void refuse_replacing(const jobs::JobStore& store, const fs::path& dir, const std::string& id,
+                      bool force) {
+  const jobs::Status s = store.read_status("");
+  if (force || s.state != jobs::State::Done || s.id == id) return;
+  std::ifstream in(dir / "job.json");
+  const auto job = nlohmann::json::parse(in, nullptr, false);
+  const std::string was = job.is_object() && job.contains("label") && job["label"].is_string()
+                              ? job["label"].get<std::string>()
+                              : std::string("unnamed");
+  throw config::ConfigError(
+      fmt::format("impact into {}: the folder holds a finished impact made with other inputs ({}, "
+                  "job {}); this impact would "
+                  "replace it. Use another --output, or --force to replace it",
+                  dir.string(), was, s.id));
+}
+
+// Run, skip or busy for the impact, with a damaged output counted as not done.
+jobs::Verdict impact_verdict(const jobs::JobStore& store, const RunOptions& opts,
+                             const std::string& label, const nlohmann::json& inputs) {
+  jobs::Verdict v = store.decide(label, inputs, opts.force);
+  if (v.decision == jobs::Decision::Skip)
+    if (const std::string why = breakage::damaged_impact_outputs(opts.output); !why.empty())
+      v = {jobs::Decision::Run, "done before, but an output is damaged: " + why};
+  if (v.decision == jobs::Decision::Busy)
+    throw std::runtime_error(fmt::format("impact into {}: {}", opts.output.string(), v.why));
+  return v;
+}
+
+}  // namespace
+
 int run_single_impact(const config::CaseConfig& cfg, const RunOptions& opts, double velocity,
-                      double angle, int repeat, std::ostream& out) {
+                      double angle, int repeat, bool dry_run, std::ostream& out) {
   engine::Runner runner;
   Progress progress(out, isatty(STDOUT_FILENO) && &out == &std::cout);
   StageContext ctx{cfg, opts, opts.output, opts.output / "breakage", runner, progress};
@@ -482,12 +578,8 @@ int run_single_impact(const config::CaseConfig& cfg, const RunOptions& opts, dou
   // The output folder is the job's folder: an identical rerun is skipped.
   const jobs::JobStore store = jobs::JobStore::single(opts.output);
   const nlohmann::json inputs = breakage::impact_inputs(ctx, velocity, angle, repeat);
-  jobs::Verdict v = store.decide(label, inputs, opts.force);
-  if (v.decision == jobs::Decision::Skip)
-    if (const std::string why = breakage::damaged_impact_outputs(opts.output); !why.empty())
-      v = {jobs::Decision::Run, "done before, but an output is damaged: " + why};
-  if (v.decision == jobs::Decision::Busy)
-    throw std::runtime_error(fmt::format("impact into {}: {}", opts.output.string(), v.why));
+  refuse_replacing(store, opts.output, jobs::job_id(inputs), opts.force);
+  const jobs::Verdict v = impact_verdict(store, opts, label, inputs);
   if (v.decision == jobs::Decision::Skip) {
     std::ifstream in(opts.output / "result.json");
     out << breakage::impact_line(nlohmann::json::parse(in, nullptr, false)) << "\n"
@@ -495,7 +587,15 @@ int run_single_impact(const config::CaseConfig& cfg, const RunOptions& opts, dou
         << "): " << opts.output.string() << "; --force redoes it\n";
     return kExitOk;
   }
-  write_provenance(cfg, opts.output);
+  if (dry_run) {
+    out << fmt::format(
+        "impact {} ({}): would run a {}-element lump of {} at {:g} m/s, {:g} deg into {} (job {}); "
+        "dry run: nothing run or written\n",
+        label, v.why, cfg.doc.integer("lump.n_elements"), cfg.ore.str("name"), velocity, angle,
+        opts.output.string(), jobs::job_id(inputs));
+    return kExitOk;
+  }
+  write_provenance(cfg, opts.output, FolderKind::Impact);
   if (v.why != "new") progress.info(fmt::format("impact: rerun: {}", v.why));
   progress.info(fmt::format("impact: {}-element lump of {} at {:g} m/s, {:g} deg, into {}",
                             cfg.doc.integer("lump.n_elements"), cfg.ore.str("name"), velocity,

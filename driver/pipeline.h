@@ -32,13 +32,10 @@ struct Invocation {
 // Run the invocation; returns an ExitCode (or 128+signal when interrupted).
 int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostream& out);
 
-// `orchestrate impact`: one impact into opts.output (no job bookkeeping).
+// `orchestrate impact`: one impact into opts.output, the folder being the
+// job's own (job.json, STATUS); `dry_run` prints what it would do.
 int run_single_impact(const config::CaseConfig& cfg, const RunOptions& opts, double velocity, double angle,
-                      int repeat, std::ostream& out);
-
-// A run folder belongs to one case: throws a ConfigError naming both cases
-// when `run_dir` holds another case's results (unless `force`).
-void check_run_folder(const config::CaseConfig& cfg, const std::filesystem::path& run_dir, bool force);
+                      int repeat, bool dry_run, std::ostream& out);
 
 // Number of jobs the (single) stage of `inv` has for this case.
 int count_tasks(const config::CaseConfig& cfg, const Invocation& inv);

@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -62,6 +63,10 @@ void install_signal_forwarding() {
 }
 
 int pending_signal() { return g_signal.load(); }
+
+void throw_if_interrupted() {
+  if (const int sig = pending_signal()) throw Interrupted(sig);
+}
 
 std::string find_program(const std::string& name) {
   if (name.find('/') != std::string::npos) return access(name.c_str(), X_OK) == 0 ? name : "";
@@ -189,10 +194,16 @@ Result Runner::run(const Command& cmd, const Poll& poll) {
   envp.push_back(nullptr);
 
   const auto t0 = std::chrono::steady_clock::now();
+  const pid_t parent = getpid();
   pid_t pid = fork();
   if (pid < 0) throw std::runtime_error(std::string("fork failed: ") + strerror(errno));
   if (pid == 0) {
     setpgid(0, 0);  // own process group: signals reach the whole engine tree
+    // An orchestrate killed outright (SIGKILL) forwards nothing: the kernel
+    // then sends SIGTERM to the engine, which mpirun passes to its ranks.
+    // It fires when the forking thread ends; that thread waits for the child.
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(125);  // orchestrate died before the prctl
     int fd = open(cmd.log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (fd < 0) _exit(126);
     dup2(fd, 1);

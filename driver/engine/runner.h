@@ -76,6 +76,9 @@ Result run_python(Runner& runner, const std::filesystem::path& script,
 void install_signal_forwarding();
 // The signal received so far, 0 if none.
 int pending_signal();
+// Throws Interrupted when SIGINT or SIGTERM has arrived: long loops that
+// start no child (planning) call it so that they stop as a run does.
+void throw_if_interrupted();
 
 // Environment for OpenFOAM binaries (WM_PROJECT_DIR etc.).
 std::map<std::string, std::string> openfoam_env();

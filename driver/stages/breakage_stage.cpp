@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/runner.h"
 #include "jobs/job_store.h"
+#include "jobs/output_checks.h"
 #include "postprocess/impact_conditions.h"
 #include "progress.h"
 #include "stages/breakage/campaign.h"
@@ -41,6 +43,7 @@ bool plan_binned(const StageContext& ctx, const nlohmann::json& base, double rpm
                                       static_cast<int>(d.integer("breakage.velocity_bins")));
   for (const auto& c : conds)
     for (long r = 0; r < d.integer("breakage.repeats"); ++r) {
+      engine::throw_if_interrupted();  // a plan of many jobs stops on SIGINT/SIGTERM
       const double v = std::round(c.velocity_m_s * 10) / 10;
       const double a = std::clamp(std::round(c.angle_deg * 10) / 10, 1.0, 90.0);
       nlohmann::json in = base;
@@ -68,6 +71,7 @@ void plan_sweep(const StageContext& ctx, const nlohmann::json& base, Plan& p) {
   for (double v : d.reals("breakage.velocities"))
     for (double a : d.reals("breakage.angles"))
       for (long r = 0; r < d.integer("breakage.repeats"); ++r) {
+        engine::throw_if_interrupted();  // a plan of many jobs stops on SIGINT/SIGTERM
         nlohmann::json in = base;
         in["velocity"] = v;
         in["angle"] = a;
@@ -83,6 +87,40 @@ void plan_sweep(const StageContext& ctx, const nlohmann::json& base, Plan& p) {
 std::string BreakageStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
   const fs::path dir = jobs::JobStore(ctx.stage_dir).job_dir(job.label);
   return is_in_mill_job(job) ? damaged_in_mill_outputs(dir) : damaged_impact_outputs(dir);
+}
+
+// The merged tables and summaries of the impacts (and the mill product of
+// conditions from transport), each parsed the way the report reads it.
+std::string BreakageStage::damaged_merged_outputs(const StageContext& ctx,
+                                                  const std::vector<JobSpec>& jobs) const {
+  const size_t n_impacts = static_cast<size_t>(
+      std::count_if(jobs.begin(), jobs.end(), [](const JobSpec& j) { return !is_in_mill_job(j); }));
+  if (n_impacts == 0) return "";
+  const fs::path dir = ctx.stage_dir;
+  std::vector<std::string> r = {jobs::check_file(dir / "summary.csv"),
+                                jobs::check_file(dir / "fractions.csv")};
+  if (r[0].empty()) try {
+      const size_t rows = post::ReadSummaryCsv((dir / "summary.csv").string()).size();
+      if (rows != n_impacts)
+        r[0] = fmt::format("{}: {} row(s), expected {} (one per impact)",
+                           (dir / "summary.csv").string(), rows, n_impacts);
+    } catch (const std::exception& e) {
+      r[0] = e.what();
+    }
+  if (r[1].empty()) try {
+      post::ReadFractionsCsv((dir / "fractions.csv").string());
+    } catch (const std::exception& e) {
+      r[1] = e.what();
+    }
+  r.push_back(jobs::check_hdf5(dir / "breakage.h5"));
+  for (const char* f : {"critical_velocity.json", "comminution_efficiency.json",
+                        "size_distributions.json", "jk_fit.json"})
+    r.push_back(jobs::check_json(dir / f, true));
+  if (ctx.cfg.doc.str("breakage.conditions") == "transport") {
+    r.push_back(jobs::check_file(dir / "product.csv"));
+    r.push_back(jobs::check_json(dir / "product.json", true));
+  }
+  return jobs::first_problem(r);
 }
 
 std::vector<std::string> BreakageStage::reads(const config::CaseConfig& cfg) const {

@@ -22,6 +22,8 @@ class BreakageStage : public Stage {
                const std::filesystem::path& job_dir) override;
   void finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) override;
   std::string damaged_outputs(const StageContext& ctx, const JobSpec& job) const override;
+  std::string damaged_merged_outputs(const StageContext& ctx,
+                                     const std::vector<JobSpec>& jobs) const override;
   // The calibrated bonds; with breakage.conditions = transport also the
   // transport's impacts, which decide the jobs (one per binned condition).
   std::vector<std::string> reads(const config::CaseConfig& cfg) const override;

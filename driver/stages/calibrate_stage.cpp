@@ -197,6 +197,12 @@ std::string CalibrateStage::damaged_outputs(const StageContext& ctx, const JobSp
        job.inputs.contains("from_card") ? "" : jobs::check_json(dir / "report.json")});
 }
 
+// calibrate/calibrated.yaml, which the breakage stage reads.
+std::string CalibrateStage::damaged_merged_outputs(const StageContext& ctx,
+                                                   const std::vector<JobSpec>& jobs) const {
+  return jobs.empty() ? "" : jobs::check_yaml_map(ctx.stage_dir / "calibrated.yaml");
+}
+
 // Publish the job's outputs as the stage's: calibrate/calibrated.yaml, reports, plots.
 void CalibrateStage::finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) {
   if (jobs.empty()) return;

@@ -99,6 +99,12 @@ std::string FlowStage::damaged_outputs(const StageContext& ctx, const JobSpec& j
   return jobs::first_problem(r);
 }
 
+// flow_summary.json: a JSON array (the report reads it).
+std::string FlowStage::damaged_merged_outputs(const StageContext& ctx,
+                                              const std::vector<JobSpec>& jobs) const {
+  return jobs.empty() ? "" : jobs::check_json(ctx.stage_dir / "flow_summary.json", true);
+}
+
 // One summary of all rotor speeds: <run>/flow/flow_summary.json.
 void FlowStage::finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) {
   nlohmann::json all = nlohmann::json::array();

@@ -27,6 +27,8 @@ class FlowStage : public Stage {
                const std::filesystem::path& job_dir) override;
   void finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) override;
   std::string damaged_outputs(const StageContext& ctx, const JobSpec& job) const override;
+  std::string damaged_merged_outputs(const StageContext& ctx,
+                                     const std::vector<JobSpec>& jobs) const override;
 };
 
 namespace flow {

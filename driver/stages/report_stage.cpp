@@ -44,6 +44,7 @@ std::vector<fs::path> report_inputs(const fs::path& run) {
         continue;
       }
       const std::string ext = p.extension().string();
+      if (p.filename() == "stage.json") continue;  // the stage's bookkeeping, not a result
       if (it->is_regular_file() &&
           (ext == ".png" || ext == ".json" || ext == ".csv" || ext == ".md"))
         files.push_back(p);
@@ -309,6 +310,13 @@ void stage_section(std::ostringstream& o, const std::string& stage, const std::s
   for (const auto& f : inputs)
     if (fs::relative(f, in.run).begin()->string() == stage) mine.push_back(f);
   o << "<h2>" << esc(title) << "</h2>\n";
+  // Impacts that ran but were never merged are named, not left out.
+  if (stage == "breakage" && !fs::exists(in.run / "breakage" / "summary.csv") &&
+      fs::is_directory(in.run / "breakage" / "jobs"))
+    in.problems.push_back(
+        {in.run / "breakage" / "summary.csv",
+         "missing: the breakage stage has jobs but no merged table of them (finish it with "
+         "--stage breakage)"});
   if (stage == "flow" && fs::is_directory(in.figures))
     for (const auto& f : fs::directory_iterator(in.figures))
       if (f.path().filename().string().rfind("flow_convergence_", 0) == 0)

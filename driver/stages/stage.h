@@ -83,6 +83,12 @@ class Stage {
   // A job is done only if its declared outputs exist and parse: "" when they
   // do, else what is missing or damaged (the job is then run again).
   virtual std::string damaged_outputs(const StageContext& /*ctx*/, const JobSpec& /*job*/) const { return ""; }
+  // The same for the merged outputs that finalize makes from `jobs` and
+  // later stages read: "" when they exist and parse, else what is damaged
+  // (rebuilt by finalize when the jobs are done).
+  virtual std::string damaged_merged_outputs(const StageContext& /*ctx*/, const std::vector<JobSpec>& /*jobs*/) const {
+    return "";
+  }
   // Earlier stages whose declared outputs this stage reads (what a scheduler
   // chain makes it wait for), and those of them whose outputs decide how many
   // jobs it has (its plan can only be made once they have run).

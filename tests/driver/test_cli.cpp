@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <fstream>
 #include <cstdio>
@@ -108,6 +109,19 @@ TEST(Cli, ListTasksOneLinePerJob) {
   for (char ch : o.text) lines += ch == '\n';
   EXPECT_EQ(lines, 4) << o.text;  // 2 speeds x 2 repeats
   EXPECT_EQ(o.text.rfind("0\tv5_a90_r0\t", 0), 0u) << o.text;
+}
+
+// --task narrows --list-tasks and --dry-run to its job.
+TEST(Cli, TaskNarrowsListTasksAndDryRun) {
+  const std::string args = "--case " + kData + "/good_small.yaml --stage breakage --task 2";
+  auto o = orchestrate(args + " --list-tasks");
+  EXPECT_EQ(o.status, 0) << o.text;
+  EXPECT_EQ(o.text.rfind("2\tv50_a90_r0\t", 0), 0u) << o.text;
+  EXPECT_EQ(std::count(o.text.begin(), o.text.end(), '\n'), 1) << o.text;
+  o = orchestrate(args + " --dry-run");
+  EXPECT_EQ(o.status, 0) << o.text;
+  EXPECT_NE(o.text.find("   2 v50_a90_r0"), std::string::npos) << o.text;
+  EXPECT_EQ(o.text.find("v5_a90_r0"), std::string::npos) << o.text;
 }
 
 TEST(Cli, TaskOutOfRange) {

@@ -1,8 +1,9 @@
 // A finished tiny run whose files are damaged: a deleted, truncated or
 // corrupted declared output makes its job run again (the log names the
 // file), a damaged input of the report is named in it, NaN reads "n/a", an
-// identical `orchestrate impact` is not redone, and a run folder refuses
-// another case. Real engine runs of a 50-element lump (about a second each).
+// identical `orchestrate impact` is not redone (nor replaced by another
+// without --force), a deleted merged table is rebuilt from its jobs, and a
+// run folder refuses another case. Real engine runs of a 50-element lump (about a second each).
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -130,23 +131,44 @@ TEST_F(DamagedRun, ReportNamesDamagedInputsAndPrintsNanAsNa) {
   EXPECT_NE(html.find("<td>n/a</td>"), std::string::npos);
   EXPECT_EQ(without_images(html).find("nan"), std::string::npos);  // base64 of a figure may hold "nan"
 
+  // A NaN count damages the merged table, which is rebuilt from the done
+  // jobs before the report reads it; a merged output without jobs to
+  // rebuild it from is named at the top of the page.
   set_csv_cell(*dir_ / "breakage/summary.csv", "n_pieces", "nan");
   fs::create_directories(*dir_ / "flow");
   spit(*dir_ / "flow/flow_summary.json", "garbage{");
   ASSERT_EQ(run("report", "nan_count.log"), 0) << log("nan_count.log");
+  EXPECT_NE(log("nan_count.log").find("[breakage] rebuild the merged outputs from its 1 done job(s)"),
+            std::string::npos)
+      << log("nan_count.log");
+  EXPECT_NE(log("nan_count.log").find("n_pieces: expected a whole number"), std::string::npos) << log("nan_count.log");
   html = slurp(*dir_ / "report/index.html");
   EXPECT_EQ(html.find("-9223372036854775808"), std::string::npos);
   EXPECT_NE(html.find("Damaged input files"), std::string::npos);
-  EXPECT_NE(html.find("n_pieces: expected a whole number"), std::string::npos);
+  EXPECT_NE(html.find("<h3>Every impact</h3>"), std::string::npos);
   EXPECT_NE(html.find("flow/flow_summary.json</code>: not valid JSON"), std::string::npos);
   EXPECT_NE(log("nan_count.log").find("flow_summary.json: not valid JSON"), std::string::npos) << log("nan_count.log");
   const auto summary = nlohmann::json::parse(slurp(*dir_ / "report/summary.json"));
-  EXPECT_EQ(summary.at("damaged_inputs").size(), 2u) << summary.dump(2);
+  EXPECT_EQ(summary.at("damaged_inputs").size(), 1u) << summary.dump(2);
 
   // The breakage stage's merge rewrites its summary from the sound job files.
   fs::remove_all(*dir_ / "flow");
   ASSERT_EQ(run("breakage", "remerge.log"), 0) << log("remerge.log");
   EXPECT_EQ(mill::post::ReadSummaryCsv((*dir_ / "breakage/summary.csv").string()).size(), 1u);
+}
+
+// A deleted merged table is rebuilt from the done jobs before the report
+// reads it: the report never leaves "Every impact" out without a word.
+TEST_F(DamagedRun, DeletedMergedSummaryIsRebuiltForTheReport) {
+  ASSERT_EQ(status_, 0);
+  fs::remove(*dir_ / "breakage/summary.csv");
+  ASSERT_EQ(run("report", "merged_deleted.log"), 0) << log("merged_deleted.log");
+  EXPECT_NE(log("merged_deleted.log").find("rebuild the merged outputs from its 1 done job(s): " + dir_->string() +
+                                           "/breakage/summary.csv: missing"),
+            std::string::npos)
+      << log("merged_deleted.log");
+  EXPECT_EQ(mill::post::ReadSummaryCsv((*dir_ / "breakage/summary.csv").string()).size(), 1u);
+  EXPECT_NE(slurp(*dir_ / "report/index.html").find("<h3>Every impact</h3>"), std::string::npos);
 }
 
 TEST_F(DamagedRun, RunFolderRefusesAnotherCase) {
@@ -174,8 +196,14 @@ TEST(ImpactRerun, IdenticalImpactIsNotRedone) {
   ASSERT_EQ(orchestrate(args, dir / "third.log"), 0) << slurp(dir / "third.log");
   EXPECT_NE(slurp(dir / "third.log").find("fractions.csv: missing"), std::string::npos) << slurp(dir / "third.log");
   EXPECT_TRUE(fs::exists(dir / "out/fractions.csv"));
-  ASSERT_EQ(orchestrate(args + " --angle 60", dir / "fourth.log"), 0) << slurp(dir / "fourth.log");
-  EXPECT_NE(slurp(dir / "fourth.log").find("inputs changed"), std::string::npos) << slurp(dir / "fourth.log");
+  // Another impact into the folder would replace the finished one: only with --force.
+  EXPECT_EQ(orchestrate(args + " --angle 60", dir / "fourth.log"), 2) << slurp(dir / "fourth.log");
+  EXPECT_NE(slurp(dir / "fourth.log").find("holds a finished impact made with other inputs (impact_v20_a90_r0"),
+            std::string::npos)
+      << slurp(dir / "fourth.log");
+  EXPECT_TRUE(fs::exists(dir / "out/result.json"));
+  ASSERT_EQ(orchestrate(args + " --angle 60 --force", dir / "fifth.log"), 0) << slurp(dir / "fifth.log");
+  EXPECT_NE(slurp(dir / "fifth.log").find("inputs changed"), std::string::npos) << slurp(dir / "fifth.log");
 }
 
 }  // namespace
