@@ -13,6 +13,7 @@
 #include <cstring>
 #include <cctype>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -473,9 +474,12 @@ nlohmann::json Document::to_json() const {
 
 nlohmann::json ore_keys(const Document& ore) {
   nlohmann::json all = ore.to_json(), out = nlohmann::json::object();
+  const auto is_check = [](const std::string& k) {
+    return std::find(std::begin(kOreCheckKeys), std::end(kOreCheckKeys), k) != std::end(kOreCheckKeys);
+  };
   for (auto it = all.begin(); it != all.end(); ++it)
     if (it.key() != "name" && it.key() != "source" && it.key().rfind("calibrated.", 0) != 0 &&
-        it.key().rfind("jk.", 0) != 0 && it.key() != kAllowOutsideRange)
+        it.key().rfind("jk.", 0) != 0 && it.key() != kAllowOutsideRange && !is_check(it.key()))
       out[it.key()] = it.value();
   return out;
 }

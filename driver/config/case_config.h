@@ -80,8 +80,9 @@ nlohmann::json outliers(const CaseConfig& c);
 // or another non-regular file, or unreadable.
 std::string read_regular_file(const std::filesystem::path& file, const std::string& what);
 
-// The ore card's macro properties (everything but name, source, calibrated.*
-// jk.* and allow_outside_range), as canonical JSON: what job ids hash and a calibration is fitted to.
+// The ore card's macro properties (everything but name, source, calibrated.*,
+// jk.*, allow_outside_range and the calibration's check keys kOreCheckKeys),
+// as canonical JSON: what job ids hash and a calibration is fitted to.
 nlohmann::json ore_keys(const Document& ore);
 
 // Physical consistency of an ore card (UCS > tensile strength, ...).

@@ -140,6 +140,16 @@ const char* kUcsSource =
 const char* kTensileSource =
     "Goodman 1989, Introduction to Rock Mechanics (2nd ed.), ch. 3: rock's tensile strength is 1/25 to "
     "1/5 of its UCS (1-500 MPa, Hoek & Brown 1997)";
+const char* kFrictionAngleSource =
+    "typical values of intact rock in triaxial tests at low confinement, about 25 deg (shales, weak "
+    "sandstones) to about 60 deg (strong crystalline rock), with a margin";
+const char* kHoekBrownMiSource =
+    "Hoek & Brown 1997, Practical estimates of rock mass strength, table of m_i for intact rock: from 4 +- 2 "
+    "(claystones) to 32 +- 3 (granite), with a margin";
+const char* kToughnessSource =
+    "typical values of rock, about 0.1 MPa m^0.5 (weak sedimentary rock) to a few MPa m^0.5 (strong "
+    "crystalline rock; Zhang 2002, Int. J. Rock Mech. Min. Sci. 39: sigma_t [MPa] ~ 6.88 K_IC "
+    "[MPa m^0.5]), with a margin";
 const char* kRockFrictionSource =
     "Byerlee 1978, Friction of rocks: 0.6-0.85 rock on rock; lower on steel and on polished surfaces";
 
@@ -384,7 +394,13 @@ std::vector<KeyDef> calibrate_keys() {
                    "Relative tolerance on E, UCS and tensile strength")),
       at_least(key("calibrate.seed", T::Int, "", "2002", "Seed of the specimen packing"), 1),
       key("calibrate.rate_check", T::Bool, "", "true",
-          "After the fit, repeat the UCS test at half the strain rate (quasi-static check)")};
+          "After the fit, repeat the UCS test at half the strain rate (quasi-static check)"),
+      range(key("calibrate.confining_pressures", T::RealList, "x ucs", "[0.1, 0.2]",
+                "After the fit, one triaxial test per entry at this confining pressure (a fraction of the UCS "
+                "the result reached: the card's ucs when met) with the result's bond parameters: the failure "
+                "envelope, a check, not fitted. At most 1/4: above it the virtual test leaves the Mohr-Coulomb "
+                "line (docs/calibration.md)"),
+            0, true, 0.25, false)};
 }
 
 // The resources of the engine runs, here and per stage on a cluster.
@@ -437,6 +453,24 @@ Schema make_ore_schema() {
       plausible(at_least(key("friction", T::Real, "", "0.5", "Coulomb friction coefficient (element-element and walls)"), 0),
                 0.05, 1.5, "a rock's friction coefficient", kRockFrictionSource),
       range(key("restitution", T::Real, "", "0.5", "Coefficient of restitution"), 0, true, 1, false),
+      // The rock's failure envelope and toughness, optional: the calibration
+      // checks its result against them (docs/calibration.md, "Checks after
+      // the fit"); they change no simulation and no fitted parameter.
+      opt(plausible(range(key("friction_angle", T::Real, "deg", "",
+                              "Internal friction angle phi of the intact rock (Mohr-Coulomb, from triaxial tests "
+                              "over the calibration's confinement, calibrate.confining_pressures); the calibration "
+                              "reports its envelope against it (a check, not fitted)"),
+                          0, true, 90, true),
+                    10, 70, "a rock's internal friction angle", kFrictionAngleSource)),
+      opt(plausible(positive(key("hoek_brown_mi", T::Real, "", "",
+                                 "Hoek-Brown constant m_i of the intact rock (Hoek & Brown 1997); the calibration "
+                                 "reports its envelope's m_i against it (a check, not fitted)")),
+                    1, 50, "a rock's Hoek-Brown m_i", kHoekBrownMiSource)),
+      opt(plausible(positive(key("fracture_toughness", T::Real, "Pa m^0.5", "",
+                                 "Mode-I fracture toughness K_IC; given, the calibration runs a semi-circular bend "
+                                 "test (Kuruppu et al. 2014) and reports its K_IC against it (a check, not fitted)")),
+                    2e4, 1e7, "a rock's mode-I fracture toughness", kToughnessSource,
+                    {{"kPa m^0.5", 1e3}, {"MPa m^0.5", 1e6}})),
       // Measured JK drop-weight parameters (Napier-Munn et al. 1996), optional:
       // drawn against the breakage sweep's own fit; they change no simulation.
       opt(range(key("jk.A", T::Real, "%", "", "Measured JK breakage parameter A: the largest t10 of the ore (drop-weight test); give with jk.b"), 0, true, 100, false)),

@@ -70,6 +70,12 @@ std::string expected_text(const KeyDef& k);
 inline constexpr long kMinLumpElements = 10;
 // The key that lists a file's deliberate outliers of their plausible range.
 inline constexpr const char* kAllowOutsideRange = "allow_outside_range";
+// The ore card keys that the calibration checks after its fit and that no
+// simulation reads (docs/calibration.md, "Checks after the fit"): they are
+// not part of the card's hash (config::ore_keys), so adding one reruns only
+// the calibration.
+inline constexpr const char* kOreCheckKeys[] = {"friction_angle", "hoek_brown_mi",
+                                                "fracture_toughness"};
 // Text for a number in messages and docs: 50, 5e7, 1.869e10 (no "e+07").
 std::string num(double v);
 // The units a value outside its plausible range was likely typed in, as

@@ -14,6 +14,7 @@
 #include "lump/bond_parameters.h"
 #include "lump/material.h"
 #include "progress.h"
+#include "stages/calibrate/checks.h"
 #include "stages/calibrate/fitting.h"
 #include "stages/calibrate/lab_runs.h"
 #include "stages/calibrate/outputs.h"
@@ -28,7 +29,7 @@ using namespace calibrate;
 
 // Bumped when a deck or the fitting scheme changes what a calibration gives
 // (git log of this line: what each version changed).
-constexpr int kDeckVersion = 3;
+constexpr int kDeckVersion = 4;
 
 // True when the ore card carries a complete calibrated.* section fitted to
 // its own macro properties (same input_hash).
@@ -76,7 +77,8 @@ class Calibration {
   int max_it_ = 1;
 };
 
-// The calibration: pack, iterate the two tests, check the rate, write.
+// The calibration: pack, iterate the two tests, check the rate, run the
+// checks (triaxial, semi-circular bend), write.
 void Calibration::run() {
   const auto t0 = std::chrono::steady_clock::now();
   fs::create_directories(dir_ / "runs");
@@ -104,8 +106,12 @@ void Calibration::run() {
         "input_hash): "
         "starting the fit from it");
   }
-  // Steps of the job: 2 tests per iteration plus the half-rate UCS (twice as long).
-  const double steps_total = 2.0 * max_it_ + 2.0;
+  // Steps of the job: 2 tests per iteration, the half-rate UCS (twice as
+  // long), then the checks.
+  const CheckTargets check_for = check_targets(ore_);
+  const double n_checks = static_cast<double>(d_.reals("calibrate.confining_pressures").size()) +
+                          (check_for.fracture_toughness ? 1.0 : 0.0);
+  const double steps_total = 2.0 * max_it_ + 2.0 + n_checks;
   for (int k = 1; k <= max_it_; ++k) {
     Iteration it;
     it.p = p;
@@ -140,6 +146,9 @@ void Calibration::run() {
     o.half = lab.ucs(
         hist[o.best].p, 0.5 * rate_,
         {"rate_check_ucs", "rate check: UCS at half the strain rate", 2.0 * max_it_ / steps_total});
+  o.checks = run_checks(lab, hist[o.best].p, hist[o.best].ucs, rate_,
+                        confining_pressures(d_, hist[o.best].ucs.r.ucs), check_for,
+                        (2.0 * max_it_ + 2.0) / steps_total, 1.0 / steps_total);
   o.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_outputs(ctx_, dir_, fit_, o);
 }
@@ -151,6 +160,8 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
   Plan p;
   nlohmann::json in = case_keys(ctx.cfg.doc, {"calibrate.", "lump."});
   in["ore"] = config::ore_keys(ctx.cfg.ore);
+  for (const char* k : config::kOreCheckKeys)
+    if (ctx.cfg.ore.has(k)) in["ore_checks"][k] = ctx.cfg.ore.real(k);
   in["deck_version"] = kDeckVersion;
   const bool from_card = card_is_calibrated(ctx.cfg);
   if (card_has_stale_calibration(ctx.cfg)) {
@@ -168,8 +179,11 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
       {"calibration", in,
        from_card
            ? fmt::format("copy calibrated.* from the ore card of {}", ctx.cfg.ore.str("name"))
-           : fmt::format("UCS + Brazilian tests on {} elements, fit to {}",
-                         ctx.cfg.doc.integer("calibrate.n_elements"), ctx.cfg.ore.str("name"))});
+           : fmt::format("UCS + Brazilian tests on {} elements, fit to {}; then {} triaxial{} "
+                         "check(s)",
+                         ctx.cfg.doc.integer("calibrate.n_elements"), ctx.cfg.ore.str("name"),
+                         ctx.cfg.doc.reals("calibrate.confining_pressures").size(),
+                         ctx.cfg.ore.has("fracture_toughness") ? " + semi-circular bend" : "")});
   return p;
 }
 

@@ -85,6 +85,32 @@ TEST(CalibrateEnergy, WorstResidualIsNamedByItsRun) {
   EXPECT_EQ(energy_summary_json(o).at("worst_run").get<std::string>(), "rate_check_ucs");
 }
 
+// The checks' runs follow the rate check, triaxial tests first, and count
+// towards the worst residual like the others.
+TEST(CalibrateEnergy, CheckRunsComeLastAndCount) {
+  Outcome o;
+  o.hist = {iteration(1, 1e-5, 3e-4)};
+  o.half = UcsRun{};
+  o.half->tag = "rate_check_ucs";
+  for (const char* tag : {"triaxial_1", "triaxial_2"}) {
+    o.checks.triaxial.emplace_back();
+    o.checks.triaxial.back().tag = tag;
+  }
+  o.checks.scb = ScbRun{};
+  o.checks.scb->tag = "scb";
+  o.checks.scb->energy = ledger(0.0, 3e-3, 1e-3, 1e-4);
+  o.checks.scb->energy.residual_fraction_max = 6e-3;
+  const auto runs = lab_runs(o);
+  ASSERT_EQ(runs.size(), 6u);
+  EXPECT_EQ(runs[3]->tag, "triaxial_1");
+  EXPECT_EQ(runs[4]->tag, "triaxial_2");
+  EXPECT_EQ(runs[5]->tag, "scb");
+  EXPECT_EQ(energy_summary_json(o).at("worst_run").get<std::string>(), "scb");
+  const std::string md = energy_markdown(o);
+  for (const char* row : {"| triaxial_1 |", "| triaxial_2 |", "| scb |"})
+    EXPECT_NE(md.find(row), std::string::npos) << row << " in\n" << md;
+}
+
 // One row per run, the result's runs marked, and the worst residual line.
 TEST(CalibrateEnergy, MarkdownSectionHasEveryRunAndTheWorst) {
   Outcome o;

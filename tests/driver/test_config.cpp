@@ -71,6 +71,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_resources_np.yaml", {":3:", "resources.breakage.np", "integer >= 1", "got 0"}},
         BadCase{"bad_ore_jk_A.yaml", {"bad_ore_jk_A_card.yaml:8:", "jk.A", "120", "(0, 100] %"}},
         BadCase{"bad_ore_jk_pair.yaml", {"bad_ore_jk_pair_card.yaml:8:", "jk.b", "without jk.A"}},
+        BadCase{"ore_friction_angle.yaml", {"ore_friction_angle_card.yaml:7:", "friction_angle", "120", "(0, 90) deg"}},
+        BadCase{"bad_confining_pressure.yaml", {":3:", "calibrate.confining_pressures[1]", "0.5", "(0, 0.25] x ucs"}},
         BadCase{"slip_ucs_mpa.yaml", {"slip_ucs_mpa_card.yaml:5:", "ucs: 50 Pa", "did you mean 50 MPa", "Hoek & Brown 1997",
                                       "allow_outside_range"}},
         BadCase{"slip_mill_mm.yaml", {":4:", "mill.flywheel.diameter: 1000 m", "did you mean 1000 mm (1 m)?"}},
@@ -138,6 +140,32 @@ TEST(OreCard, AllowedOutlierIsRecorded) {
   EXPECT_DOUBLE_EQ(all[0]["value"].get<double>(), 0.5e6);
   EXPECT_EQ(all[1]["key"], "tensile_strength");
   EXPECT_FALSE(mill::config::ore_keys(c.ore).contains("allow_outside_range"));
+}
+
+// The calibration's check keys (friction angle, m_i, K_IC) are read from the
+// card but change no job id and no calibration hash (ore_keys leaves them out).
+TEST(OreCard, CheckKeysAreReadButNotHashed) {
+  const auto ore = mill::config::Document::load(kProject / "liggghts_inputs/materials/sandstone.yaml",
+                                                mill::config::ore_schema());
+  EXPECT_DOUBLE_EQ(ore.real("hoek_brown_mi"), 17.0);
+  EXPECT_DOUBLE_EQ(ore.real("friction_angle"), 47.0);
+  EXPECT_DOUBLE_EQ(ore.real("fracture_toughness"), 0.73e6);
+  const auto keys = mill::config::ore_keys(ore);
+  for (const char* k : mill::config::kOreCheckKeys) EXPECT_FALSE(keys.contains(k)) << k;
+  EXPECT_TRUE(keys.contains("ucs"));
+}
+
+// A K_IC typed in MPa m^0.5 is named as such.
+TEST(OreCard, ToughnessInMegapascalsIsNamed) {
+  try {
+    mill::config::Document::parse("name: r\ndensity: 2580\nyoungs_modulus: 18.69e9\npoisson_ratio: 0.18\n"
+                                  "ucs: 50.0e6\ntensile_strength: 5.0e6\nfracture_toughness: 0.73\n",
+                                  "card.yaml", mill::config::ore_schema());
+    FAIL() << "accepted K_IC 0.73 Pa m^0.5";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("card.yaml:7: fracture_toughness"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("0.73 MPa m^0.5"), std::string::npos) << e.what();
+  }
 }
 
 // Every bundled ore card and case lies inside the plausible ranges.

@@ -43,6 +43,8 @@ std::vector<const LabRun*> lab_runs(const Outcome& o) {
     runs.push_back(&it.br);
   }
   if (o.half) runs.push_back(&*o.half);
+  for (const TriaxialRun& t : o.checks.triaxial) runs.push_back(&t);
+  if (o.checks.scb) runs.push_back(&*o.checks.scb);
   return runs;
 }
 
@@ -60,7 +62,9 @@ nlohmann::json energy_summary_json(const Outcome& o) {
          "jobs/calibration/runs/<run>/ledger.csv (fix energy/ledger, "
          "docs/styles/fix_energy_ledger.md); each run's figures are in its `energy` object "
          "(iterations[].energy.ucs, .brazilian, rate_check.energy)"},
-        {"work_other_J", "the platens' drive: work done on the specimen by the moving platens"},
+        {"work_other_J",
+         "the platens' drive: work done on the specimen by the moving platens (triaxial: and by "
+         "the confining forces)"},
         {"residual_fraction", "residual_J / (input_J + |work_other_J|), last row"},
         {"residual_fraction_max", "largest |residual_J| / (input_J + |work_other_J|) of any row"},
         {"comminution_efficiency",

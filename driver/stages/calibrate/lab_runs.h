@@ -1,7 +1,9 @@
 // The virtual lab tests of the calibrate stage: the UCS and Brazilian decks
-// (liggghts_inputs/{ucs,brazilian}.in.tmpl) run on the carved specimens, their
-// curves read and analysed, their energy ledgers summarised
-// (docs/calibration.md, steps 3 and 4, and "Energy ledger").
+// (liggghts_inputs/{ucs,brazilian}.in.tmpl) of the fit, and the triaxial and
+// semi-circular bend decks ({triaxial,scb}.in.tmpl) of the checks, run on the
+// carved specimens, their curves read and analysed, their energy ledgers
+// summarised (docs/calibration.md, steps 3 and 4, "Checks after the fit" and
+// "Energy ledger").
 #pragma once
 
 #include <filesystem>
@@ -45,6 +47,15 @@ struct BrazilianRun : LabRun {
   post::BrazilianResult r;
 };
 
+struct TriaxialRun : LabRun {
+  double pressure = 0;  // Pa, the confining pressure asked
+  post::TriaxialResult r;
+};
+
+struct ScbRun : LabRun {
+  post::ScbResult r;
+};
+
 // One run of a lab test: its folder <dir>/runs/<tag>, what the progress line
 // shows, and the fraction of the job done before it.
 struct RunStep {
@@ -63,11 +74,15 @@ class LabBench {
   UcsRun ucs(const BondParams& p, double rate, const RunStep& step);
   // A Brazilian test with bond parameters p at the given strain rate.
   BrazilianRun brazilian(const BondParams& p, double rate, const RunStep& step);
+  // A triaxial test on the UCS cylinder under confining pressure `pressure` [Pa].
+  TriaxialRun triaxial(const BondParams& p, double rate, double pressure, const RunStep& step);
+  // A semi-circular bend test on a half disc of the Brazilian disc's radius.
+  ScbRun scb(const BondParams& p, double rate, const RunStep& step);
 
  private:
   struct Test;
-  void run_test(const Test& test, const BondParams& p, double rate, const RunStep& step,
-                LabRun& out);
+  std::filesystem::path run_test(const Test& test, const BondParams& p, double rate,
+                                 const RunStep& step, LabRun& out);
   engine::Result run_lab_deck(const std::string& deck, const std::filesystem::path& work,
                               std::vector<std::pair<std::string, std::string>> vars,
                               const RunStep& step);

@@ -231,6 +231,7 @@ nlohmann::json Report::json() const {
                                             {"energy", lab_energy_json(half_->energy)},
                                             {"wall_seconds", half_->seconds}}
                            : nlohmann::json(nullptr)},
+      {"checks", checks_json(o_.checks, b_.ucs.r.ucs)},
       {"energy", energy_summary_json(o_)},
       {"not_reached", missed_},
       {"notes", notes_},
@@ -320,6 +321,7 @@ std::string Report::markdown() const {
         rate_ok_ ? "below 5%: quasi-static" : "5% or more: lower calibrate.strain_rate");
   else
     md << "\n## Loading rate\n\nNot checked (calibrate.rate_check: false).\n";
+  md << checks_markdown(o_.checks, b_.ucs.r.ucs);
   md << energy_markdown(o_);
   md << fmt::format(
       "\n## Specimens\n\nCarved from a ball of {} elements (seed {}), mean element radius {:.3f} "
@@ -363,6 +365,12 @@ std::string Report::curves() const {
   if (half_)
     append_curves(cv, "rate_check_ucs", static_cast<int>(best_ + 1), "ucs", 0.5 * rate_,
                   half_->curve, half_->ss.strain, half_->ss.stress);
+  for (const TriaxialRun& t : o_.checks.triaxial) {
+    const post::StressStrain ss = post::ToStressStrain(
+        t.curve, info_or_zero(t.info, "gauge_length"), info_or_zero(t.info, "end_area"));
+    append_curves(cv, t.tag, static_cast<int>(best_ + 1), "triaxial", rate_, t.curve, ss.strain,
+                  ss.stress);
+  }
   return cv.str();
 }
 
@@ -370,11 +378,15 @@ std::string Report::curves() const {
 std::string Report::summary() const {
   return fmt::format(
       "[calibrate] {}: E {:.2f} GPa, nu {:.3f}, UCS {:.1f} MPa, tensile {:.2f} MPa "
-      "(iteration {}){}",
+      "(iteration {}){}{}",
       b_.converged ? "converged" : "NOT all targets reached", b_.ucs.r.youngs_modulus / 1e9,
       b_.ucs.r.poisson_ratio, b_.ucs.r.ucs / 1e6, b_.br.r.tensile_strength / 1e6, best_ + 1,
       half_ ? fmt::format("; rate check: UCS changes {:.1f}% at half the rate", 100 * rate_change_)
-            : "");
+            : "",
+      o_.checks.mc ? fmt::format("; envelope (a check, not fitted): friction angle {:.1f} deg, "
+                                 "cohesion {:.2f} MPa",
+                                 o_.checks.mc->friction_angle_deg, o_.checks.mc->cohesion / 1e6)
+                   : "");
 }
 
 }  // namespace
@@ -398,6 +410,9 @@ void write_outputs(StageContext& ctx, const fs::path& dir, const Fitting& fit, c
           r.yaml() + "\n");
   ctx.progress.info(r.summary());
   for (const auto& m : r.missed()) ctx.progress.warn("[calibrate] not reached: " + m);
+  if (!o.checks.envelope_error.empty())
+    ctx.progress.warn("[calibrate] check: no failure envelope from the triaxial peaks: " +
+                      o.checks.envelope_error);
 }
 
 // The card's own calibrated.* section, copied (no fitting).

@@ -1,0 +1,197 @@
+// The checks after the fit: triaxial envelope and semi-circular bend toughness.
+#include "stages/calibrate/checks.h"
+
+#include <fmt/format.h>
+
+#include <sstream>
+#include <stdexcept>
+
+#include "stages/calibrate/energy_report.h"
+
+namespace mill::calibrate {
+
+namespace {
+
+// The card's value of an optional key, empty when absent.
+std::optional<double> optional_real(const config::Document& ore, const std::string& key) {
+  return ore.has(key) ? std::optional<double>(ore.real(key)) : std::nullopt;
+}
+
+// {target, achieved, relative_error}; target and error null without a target.
+nlohmann::json compared(const std::optional<double>& target, std::optional<double> achieved) {
+  nlohmann::json j = {{"target", target ? nlohmann::json(*target) : nlohmann::json(nullptr)},
+                      {"achieved", achieved ? nlohmann::json(*achieved) : nlohmann::json(nullptr)},
+                      {"relative_error", nullptr}};
+  if (target && achieved) j["relative_error"] = post::RelativeError(*achieved, *target);
+  return j;
+}
+
+// One row of report.md's comparison table.
+std::string compared_row(const char* what, const std::optional<double>& target,
+                         const std::optional<double>& achieved, double scale, int digits) {
+  const auto v = [&](const std::optional<double>& x) {
+    return x ? fmt::format("{:.{}f}", *x / scale, digits) : std::string("-");
+  };
+  return fmt::format("| {} | {} | {} | {} |\n", what, v(target), v(achieved),
+                     target && achieved
+                         ? fmt::format("{:.1f}%", 100 * post::RelativeError(*achieved, *target))
+                         : std::string("-"));
+}
+
+}  // namespace
+
+CheckTargets check_targets(const config::Document& ore) {
+  return {optional_real(ore, "friction_angle"), optional_real(ore, "hoek_brown_mi"),
+          optional_real(ore, "fracture_toughness")};
+}
+
+std::vector<double> confining_pressures(const config::Document& d, double ucs_reached) {
+  std::vector<double> p;
+  for (double f : d.reals("calibrate.confining_pressures")) p.push_back(f * ucs_reached);
+  return p;
+}
+
+// Triaxial runs, the envelope through their peaks and the UCS, then the SCB run.
+Checks run_checks(LabBench& lab, const BondParams& p, const UcsRun& ucs, double rate,
+                  const std::vector<double>& pressures, const CheckTargets& targets, double done,
+                  double step_share) {
+  Checks c;
+  c.targets = targets;
+  std::vector<post::StrengthPoint> points = {{0.0, ucs.r.ucs}};
+  for (size_t k = 0; k < pressures.size(); ++k) {
+    const std::string tag = fmt::format("triaxial_{}", k + 1);
+    try {
+      c.triaxial.push_back(
+          lab.triaxial(p, rate, pressures[k],
+                       {tag, fmt::format("check: triaxial at {:.3g} MPa", pressures[k] / 1e6),
+                        done + static_cast<double>(k) * step_share}));
+    } catch (const std::exception& e) {
+      throw std::runtime_error(fmt::format("check {} (runs/{}, confinement {:.3g} MPa): {}", tag,
+                                           tag, pressures[k] / 1e6, e.what()));
+    }
+    const TriaxialRun& t = c.triaxial.back();
+    points.push_back({t.r.sigma3, t.r.sigma1});
+    if (!t.peaked) c.notes.push_back(tag + ": reached its strain cap still loading");
+  }
+  try {
+    c.mc = post::FitMohrCoulomb(points);
+  } catch (const std::exception& e) {
+    c.envelope_error = e.what();
+  }
+  try {
+    c.hb = post::FitHoekBrown(points);
+  } catch (const std::exception& e) {
+    c.envelope_error += (c.envelope_error.empty() ? "" : "; ") + std::string(e.what());
+  }
+  if (targets.fracture_toughness) {
+    try {
+      c.scb = lab.scb(p, rate,
+                      {"scb", "check: semi-circular bend",
+                       done + static_cast<double>(pressures.size()) * step_share});
+    } catch (const std::exception& e) {
+      throw std::runtime_error(fmt::format("check scb (runs/scb): {}", e.what()));
+    }
+  }
+  if (c.scb && !c.scb->peaked) c.notes.push_back("scb: reached its cap still loading");
+  return c;
+}
+
+// Runs, envelope, targets and their comparison.
+nlohmann::json checks_json(const Checks& c, double ucs_peak) {
+  nlohmann::json tri = nlohmann::json::array();
+  nlohmann::json points = nlohmann::json::array({{{"sigma3_Pa", 0.0}, {"sigma1_Pa", ucs_peak}}});
+  for (const TriaxialRun& t : c.triaxial) {
+    tri.push_back({{"run", t.tag},
+                   {"confining_pressure_Pa", t.pressure},
+                   {"sigma3_Pa", t.r.sigma3},
+                   {"sigma1_Pa", t.r.sigma1},
+                   {"deviator_Pa", t.r.deviator},
+                   {"strain_at_peak", t.r.strain_at_peak},
+                   {"bonds_broken_by_confinement", t.r.broken_before_loading},
+                   {"peaked", t.peaked},
+                   {"energy", lab_energy_json(t.energy)},
+                   {"wall_seconds", t.seconds}});
+    points.push_back({{"sigma3_Pa", t.r.sigma3}, {"sigma1_Pa", t.r.sigma1}});
+  }
+  nlohmann::json env = {
+      {"points", points},
+      {"mohr_coulomb", c.mc ? nlohmann::json{{"friction_angle_deg", c.mc->friction_angle_deg},
+                                             {"cohesion_Pa", c.mc->cohesion},
+                                             {"ucs_Pa", c.mc->ucs},
+                                             {"q", c.mc->q}}
+                            : nlohmann::json(nullptr)},
+      {"hoek_brown", c.hb ? nlohmann::json{{"m_i", c.hb->m_i}, {"sigma_ci_Pa", c.hb->sigma_ci}}
+                          : nlohmann::json(nullptr)},
+      {"error",
+       c.envelope_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.envelope_error)}};
+  nlohmann::json scb = nullptr;
+  if (c.scb)
+    scb = {{"run", c.scb->tag},
+           {"peak_force_N", c.scb->r.peak_force},
+           {"geometry_factor", c.scb->r.geometry_factor},
+           {"fracture_toughness_Pa_m0.5", c.scb->r.toughness},
+           {"peaked", c.scb->peaked},
+           {"energy", lab_energy_json(c.scb->energy)},
+           {"wall_seconds", c.scb->seconds}};
+  const auto mc = [&](auto f) { return c.mc ? std::optional<double>(f(*c.mc)) : std::nullopt; };
+  return {
+      {"note",
+       "checks with the result's bond parameters, not fitted: not a lever yet (no bond parameter "
+       "moves on them)"},
+      {"triaxial", tri},
+      {"envelope", env},
+      {"scb", scb},
+      {"notes", c.notes},
+      {"against_card",
+       {{"friction_angle",
+         compared(c.targets.friction_angle_deg,
+                  mc([](const post::MohrCoulomb& m) { return m.friction_angle_deg; }))},
+        {"hoek_brown_mi",
+         compared(c.targets.hoek_brown_mi, c.hb ? std::optional<double>(c.hb->m_i) : std::nullopt)},
+        {"fracture_toughness",
+         compared(c.targets.fracture_toughness,
+                  c.scb ? std::optional<double>(c.scb->r.toughness) : std::nullopt)}}}};
+}
+
+// Peaks, envelope and the card's values, with what they are not.
+std::string checks_markdown(const Checks& c, double ucs_peak) {
+  std::ostringstream md;
+  md << "\n## Checks after the fit (not a lever yet)\n\n"
+        "The result's bond parameters in triaxial tests (confinement on the lateral shell, "
+        "docs/calibration.md) and, when the ore card gives K_IC, a semi-circular bend test. "
+        "These are checks, not fitted: no bond parameter moves on them.\n\n"
+        "| run | sigma_3 (MPa) | peak sigma_1 (MPa) | sigma_1 - sigma_3 (MPa) | peaked |\n"
+        "|---|---|---|---|---|\n";
+  md << fmt::format("| UCS (result) | 0 | {:.2f} | {:.2f} | |\n", ucs_peak / 1e6, ucs_peak / 1e6);
+  for (const TriaxialRun& t : c.triaxial)
+    md << fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} | {} |\n", t.tag, t.r.sigma3 / 1e6,
+                      t.r.sigma1 / 1e6, t.r.deviator / 1e6, t.peaked ? "yes" : "no (cap)");
+  md << "\n";
+  if (c.mc)
+    md << fmt::format(
+        "Mohr-Coulomb through the {} peaks: friction angle {:.1f} deg, cohesion {:.2f} MPa "
+        "(sigma_1 = {:.2f} MPa + {:.2f} sigma_3). ",
+        c.triaxial.size() + 1, c.mc->friction_angle_deg, c.mc->cohesion / 1e6, c.mc->ucs / 1e6,
+        c.mc->q);
+  if (c.hb)
+    md << fmt::format("Hoek-Brown: m_i {:.1f}, sigma_ci {:.2f} MPa. ", c.hb->m_i,
+                      c.hb->sigma_ci / 1e6);
+  if (!c.envelope_error.empty()) md << "Not fitted: " << c.envelope_error << ".";
+  md << "\n";
+  if (c.scb)
+    md << fmt::format("\nSemi-circular bend: peak {:.1f} N, Y' {:.2f}, K_IC {:.3f} MPa m^0.5{}.\n",
+                      c.scb->r.peak_force, c.scb->r.geometry_factor, c.scb->r.toughness / 1e6,
+                      c.scb->peaked ? "" : " (reached its cap still loading)");
+  md << "\n| property | ore card | achieved | error |\n|---|---|---|---|\n";
+  md << compared_row("friction angle (deg)", c.targets.friction_angle_deg,
+                     c.mc ? std::optional<double>(c.mc->friction_angle_deg) : std::nullopt, 1.0, 1);
+  md << compared_row("Hoek-Brown m_i", c.targets.hoek_brown_mi,
+                     c.hb ? std::optional<double>(c.hb->m_i) : std::nullopt, 1.0, 1);
+  md << compared_row("K_IC (MPa m^0.5)", c.targets.fracture_toughness,
+                     c.scb ? std::optional<double>(c.scb->r.toughness) : std::nullopt, 1e6, 3);
+  if (!c.notes.empty()) md << "\n";
+  for (const std::string& n : c.notes) md << "- " << n << "\n";
+  return md.str();
+}
+
+}  // namespace mill::calibrate
