@@ -69,7 +69,6 @@ void atomic_write_with(const fs::path& file, const std::function<void(std::ostre
   fs::rename(tmp, file);
 }
 
-namespace {
 std::string utc_now() {
   std::time_t t = std::time(nullptr);
   std::tm tm{};
@@ -78,7 +77,6 @@ std::string utc_now() {
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
   return buf;
 }
-}  // namespace
 
 std::string JobStore::hostname() {
   char buf[256] = {0};

@@ -41,6 +41,9 @@ struct Verdict {
 std::string job_id(const nlohmann::json& inputs);
 
 // Write `content` to `file` atomically: FILE.tmp.<pid>, fsync, rename.
+// The time now, UTC, ISO 8601 to the second (2026-01-01T00:00:00Z).
+std::string utc_now();
+
 void atomic_write(const std::filesystem::path& file, const std::string& content);
 // Stream into FILE.tmp.<pid>, then rename: for outputs written piece by piece.
 void atomic_write_with(const std::filesystem::path& file, const std::function<void(std::ostream&)>& writer);
