@@ -535,6 +535,20 @@ void check_physics(const Document& d) {
           "mills run at 50-150 m/s; a steel rim bursts near {:g} m/s): at this diameter, rotor.rpm <= {:.0f}",
           d.where("rotor.rpm"), i, D, rpms[i], tip, kMaxTipSpeed, kMaxTipSpeed, kMaxTipSpeed * 60.0 / (kPi * D)));
   }
+  // The flat joint's layout fits its slots; broken_contact is the parallel bond's.
+  if (d.str("lump.bond_model") == "flat_joint") {
+    const long rings = d.integer("lump.joint_rings"), sectors = d.integer("lump.joint_sectors");
+    if (rings * sectors > kMaxJointElements)
+      throw ConfigError(fmt::format(
+          "{}: {} rings x {} sectors is {} elements per interface; expected at most {} (fix bond/flatjoint): "
+          "lower lump.joint_rings or lump.joint_sectors",
+          d.where("lump.joint_sectors"), rings, sectors, rings * sectors, kMaxJointElements));
+    if (d.boolean("lump.broken_contact"))
+      throw ConfigError(fmt::format(
+          "{}: lump.broken_contact is the parallel bond's; a flat joint's broken elements always stay as "
+          "frictional contacts: remove it, or set lump.bond_model: parallel",
+          d.where("lump.broken_contact")));
+  }
   check_unique_items(d, "rotor.rpm", "rpm");
   check_unique_items(d, "breakage.velocities", "m/s");
   check_unique_items(d, "breakage.angles", "deg");

@@ -311,8 +311,18 @@ std::vector<KeyDef> lump_keys() {
                 1, false, 64, false),
           bond_key("lump.bond_radius_multiplier", bond_parameter("radius_multiplier"), "1.0"),
           key("lump.broken_contact", T::Bool, "", "false",
-              "Broken bonds stay as compression-only frictional contacts while the pair is within "
-              "its bonding range (fix bond/breakable broken_contact)")};
+              "Parallel bond: broken bonds stay as compression-only frictional contacts while the pair is "
+              "within its bonding range (fix bond/breakable broken_contact)"),
+          choice("lump.bond_model", "parallel", {"parallel", "flat_joint"},
+                 "The bonded contact: parallel (a cement disc that breaks whole, fix bond/breakable; Potyondy & "
+                 "Cundall 2004) or flat_joint (an interface of elements that break one by one and stay as "
+                 "frictional contacts, fix bond/flatjoint; Potyondy 2012); docs/calibration.md"),
+          range(key("lump.joint_rings", T::Int, "", "1", "Flat joint: rings of elements per interface"), 1, false,
+                kMaxJointElements, false),
+          range(key("lump.joint_sectors", T::Int, "", "3",
+                    "Flat joint: sectors of elements per interface (at least 3: the intact interface then has the "
+                    "disc's area and moments)"),
+                3, false, kMaxJointElements, false)};
 }
 
 // The breakage stage: its sweep or transport conditions, and the in-mill runs.
@@ -482,9 +492,16 @@ Schema make_ore_schema() {
   };
   // Calibrated micro parameters (written by `--stage calibrate`, optional):
   // one key per fitted row of kBondParameters, and the hash they were fitted to.
+  const std::string cal = std::string(kCalibratedSection) + ".";
+  s.keys.push_back(opt(choice(cal + kModelKey, "", {"parallel", "flat_joint"},
+                              "Bond model the calibration was made with (absent: parallel; lump.bond_model)")));
+  s.keys.push_back(opt(range(key(cal + kRingsKey, T::Int, "", "", "Flat joint: rings of elements (lump.joint_rings)"),
+                             1, false, kMaxJointElements, false)));
+  s.keys.push_back(opt(range(key(cal + kSectorsKey, T::Int, "", "", "Flat joint: sectors of elements (lump.joint_sectors)"),
+                             3, false, kMaxJointElements, false)));
   for (const BondParameter& p : kBondParameters)
     if (p.calibrated)
-      s.keys.push_back(opt(bond_key(std::string(kCalibratedSection) + "." + p.calibrated, p, "")));
+      s.keys.push_back(opt(bond_key(cal + p.calibrated, p, "")));
   s.keys.push_back(opt(key(std::string(kCalibratedSection) + "." + kInputHashKey, T::String, "", "",
                            "Hash of the macro properties these were fitted to")));
   return s;

@@ -68,6 +68,9 @@ std::string expected_text(const KeyDef& k);
 // deck (liggghts_inputs/lump_build.in.tmpl) places only one element in its
 // sphere, whatever the seed.
 inline constexpr long kMinLumpElements = 10;
+// Most elements of one flat-joint interface (rings x sectors): the slots of
+// fix bond/flatjoint (liggghts_styles/flat_joint.h, kMaxElements).
+inline constexpr int kMaxJointElements = 32;
 // The key that lists a file's deliberate outliers of their plausible range.
 inline constexpr const char* kAllowOutsideRange = "allow_outside_range";
 // The ore card keys that the calibration checks after its fit and that no

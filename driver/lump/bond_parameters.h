@@ -24,7 +24,18 @@ namespace config {
 class Document;
 }
 
-// One set of bond parameters; each number is a row of kBondParameters.
+// The bonded contact of the lump and the specimens (the case's
+// lump.bond_model): the parallel bond of fix bond/breakable (Potyondy &
+// Cundall 2004) or the flat joint of fix bond/flatjoint (Potyondy 2012).
+enum class BondModel { parallel, flat_joint };
+// Its name in the case (lump.bond_model), calibrated.yaml and the job JSON.
+const char* bond_model_name(BondModel m);
+// The model named `name`; throws std::runtime_error for another name.
+BondModel bond_model_from(const std::string& name);
+
+// One set of bond parameters; each number is a row of kBondParameters, and
+// the model with its layout, which the case sets (lump.bond_model,
+// lump.joint_rings, lump.joint_sectors) and a calibration records.
 struct BondParams {
   double modulus = 0;             // bond modulus E_b, Pa
   double stiffness_ratio = 0;     // kn/ks
@@ -33,8 +44,21 @@ struct BondParams {
   double friction_angle_deg = 0;  // bond Mohr-Coulomb friction angle, deg
   double moment_factor = 1.0;     // beta: share of the bond moments in the bond stresses
   double radius_multiplier = 1.0;
-  std::string origin;  // where they come from, for reports
+  BondModel model = BondModel::parallel;
+  int joint_rings = 1;    // flat joint: rings of elements per interface
+  int joint_sectors = 3;  // flat joint: sectors of elements per interface
+  std::string origin;     // where they come from, for reports
 };
+
+// True when two sets are of the same model and (flat joint) element layout:
+// a calibration applies only to the model and layout it was fitted with.
+inline bool same_model(const BondParams& a, const BondParams& b) {
+  return a.model == b.model &&
+         (a.model == BondModel::parallel ||
+          (a.joint_rings == b.joint_rings && a.joint_sectors == b.joint_sectors));
+}
+// "parallel bond" or "flat joint 1 x 3", for messages and reports.
+std::string bond_model_text(const BondParams& b);
 
 // Admissible values: min < v (or <=), v < max (or <=).
 struct BondRange {
@@ -62,6 +86,7 @@ struct BondParameter {
   BondRange range;
   double start;   // the closed-form estimate (kFromCard: derived from the card)
   bool optional;  // may be absent from a calibration (one made before it existed): then `start`
+  bool parallel_only;  // a keyword of the parallel bond only (fix bond/flatjoint refuses it)
   const char* doc;
 };
 
@@ -72,20 +97,20 @@ struct BondParameter {
 // Row order is the order of the calibrated: map and of the card's schema.
 // clang-format off
 inline constexpr BondParameter kBondParameters[] = {
-//  member                           json                  calibrated               deck               keyword              unit   range                        start      optional
-  {&BondParams::modulus,            "modulus",            "bond_modulus",          "bond_modulus",    "modulus",           "Pa",  kPositive,                   kFromCard, false,
+//  member                           json                  calibrated               deck               keyword              unit   range                        start      optional parallel_only
+  {&BondParams::modulus,            "modulus",            "bond_modulus",          "bond_modulus",    "modulus",           "Pa",  kPositive,                   kFromCard, false, false,
    "Bond modulus E_b (k_n = E_b / L)"},
-  {&BondParams::stiffness_ratio,    "stiffness_ratio",    "stiffness_ratio",       "stiffness_ratio", "stiffness_ratio",   "",    kPositive,                   2.5,       false,
+  {&BondParams::stiffness_ratio,    "stiffness_ratio",    "stiffness_ratio",       "stiffness_ratio", "stiffness_ratio",   "",    kPositive,                   2.5,       false, false,
    "Bond normal/shear stiffness ratio"},
-  {&BondParams::tensile,            "tensile",            "bond_tensile_strength", "bond_tensile",    "tensile_strength",  "Pa",  kPositive,                   kFromCard, false,
+  {&BondParams::tensile,            "tensile",            "bond_tensile_strength", "bond_tensile",    "tensile_strength",  "Pa",  kPositive,                   kFromCard, false, false,
    "Bond tensile strength"},
-  {&BondParams::cohesion,           "cohesion",           "bond_cohesion",         "bond_cohesion",   "cohesion",          "Pa",  kPositive,                   kFromCard, false,
+  {&BondParams::cohesion,           "cohesion",           "bond_cohesion",         "bond_cohesion",   "cohesion",          "Pa",  kPositive,                   kFromCard, false, false,
    "Bond shear cohesion"},
-  {&BondParams::friction_angle_deg, "friction_angle_deg", "bond_friction_angle",   "bond_friction",   "friction_angle",    "deg", {0, false, 90, true},        30.0,      false,
+  {&BondParams::friction_angle_deg, "friction_angle_deg", "bond_friction_angle",   "bond_friction",   "friction_angle",    "deg", {0, false, 90, true},        30.0,      false, false,
    "Bond Mohr-Coulomb friction angle"},
-  {&BondParams::moment_factor,      "moment_factor",      "bond_moment_factor",    "moment_factor",   "moment_factor",     "",    {0, false, 1, false},        1.0,       true,
+  {&BondParams::moment_factor,      "moment_factor",      "bond_moment_factor",    "moment_factor",   "moment_factor",     "",    {0, false, 1, false},        1.0,       true, true,
    "Share of the bond moments in the bond stresses (absent: 1)"},
-  {&BondParams::radius_multiplier,  "radius_multiplier",  nullptr,                 "radius_mult",     "radius_multiplier", "",    {0, true, 2, false},         kFromCard, false,
+  {&BondParams::radius_multiplier,  "radius_multiplier",  nullptr,                 "radius_mult",     "radius_multiplier", "",    {0, true, 2, false},         kFromCard, false, false,
    "Bond disc radius = multiplier x min(Ri, Rj); at most 2, a disc twice the smaller element (Potyondy & Cundall 2004 use 1)"},  // the case's lump.bond_radius_multiplier
 };
 // clang-format on
@@ -94,6 +119,11 @@ inline constexpr BondParameter kBondParameters[] = {
 // calibrated.yaml) that ties them to the card's macro properties.
 inline constexpr const char* kCalibratedSection = "calibrated";
 inline constexpr const char* kInputHashKey = "input_hash";
+// Its keys of the model and the flat joint's layout (absent: a parallel bond,
+// from a calibration made before the flat joint existed).
+inline constexpr const char* kModelKey = "bond_model";
+inline constexpr const char* kRingsKey = "joint_rings";
+inline constexpr const char* kSectorsKey = "joint_sectors";
 
 // The row whose job JSON key is `json`; throws std::logic_error for none.
 inline const BondParameter& bond_parameter(std::string_view json) {
@@ -126,7 +156,11 @@ BondParams read_calibrated(const config::Document& ore, BondParams base);
 // fitted row and the input hash.
 bool card_has_calibration(const config::Document& ore);
 
-// -var pairs of the decks: every row's deck variable, formatted for LIGGGHTS.
+// -var pairs of the decks: every shared row's deck variable, formatted for
+// LIGGGHTS; `bond_style` (breakable or flatjoint: the style is
+// bond/${bond_style}) and `bond_model_keys`, the model's own keywords (a
+// parallel bond's moment_factor, a flat joint's elements), which the decks
+// put on their fix line as they are.
 std::vector<std::pair<std::string, std::string>> bond_deck_vars(const BondParams& b);
 
 }  // namespace mill

@@ -14,7 +14,7 @@ namespace fs = std::filesystem;
 
 std::string ore_hash(const config::Document& ore) { return jobs::job_id(config::ore_keys(ore)); }
 
-BondParams estimate_bond_params(const config::Document& ore, double radius_multiplier) {
+BondParams estimate_bond_params(const config::Document& ore, const config::Document& doc) {
   // Starting point only; `--stage calibrate` replaces it. Potyondy & Cundall
   // (2004, sec. 3 and table 1) report macro E close to the bond modulus for
   // radius multiplier 1 and kn/ks = 2.5 for nu ~ 0.2; a parallel-bond packing's
@@ -27,14 +27,26 @@ BondParams estimate_bond_params(const config::Document& ore, double radius_multi
   b.modulus = ore.real("youngs_modulus");
   b.tensile = 2.0 * ore.real("tensile_strength");
   b.cohesion = 2.0 * b.tensile;
-  b.radius_multiplier = radius_multiplier;
+  b.radius_multiplier = doc.real("lump.bond_radius_multiplier");
+  b.model = bond_model_from(doc.str("lump.bond_model"));
+  if (b.model == BondModel::flat_joint) {
+    // Flat joints at bond gap 1.0 (coordination ~10, the 400-element
+    // specimen; bench/README.md, "Strength ratio: coordination and cohesion
+    // with the flat joint"): E_b 99.9 GPa, sigma_c 24.9 MPa, c = 10 sigma_c
+    // gave E 50.4 GPa, tensile 30.6 MPa and UCS/T 9.68: start there, scaled.
+    b.modulus = 2.0 * ore.real("youngs_modulus");
+    b.tensile = 0.8 * ore.real("tensile_strength");
+    b.cohesion = 10.0 * b.tensile;
+  }
+  b.joint_rings = static_cast<int>(doc.integer("lump.joint_rings"));
+  b.joint_sectors = static_cast<int>(doc.integer("lump.joint_sectors"));
   b.origin = "closed-form estimate (not calibrated: run --stage calibrate)";
   return b;
 }
 
 namespace {
 // Read the calibrated: map of a YAML file (calibrated.yaml or the ore card)
-// if fitted to `hash`; false otherwise.
+// if fitted to `hash` with the model and layout of `b`; false otherwise.
 bool read_calibrated_file(const fs::path& file, const std::string& hash, BondParams& b) {
   if (!fs::exists(file)) return false;
   try {
@@ -42,7 +54,9 @@ bool read_calibrated_file(const fs::path& file, const std::string& hash, BondPar
     YAML::Node c = root.IsMap() ? root[kCalibratedSection] : YAML::Node();
     if (!c || !c.IsMap() || !c[kInputHashKey] || c[kInputHashKey].as<std::string>() != hash)
       return false;
-    b = read_calibrated(c, b);
+    const BondParams fitted = read_calibrated(c, b);
+    if (!same_model(fitted, b)) return false;  // fitted with another bond model
+    b = fitted;
   } catch (const std::exception& e) {
     throw std::runtime_error(
         fmt::format("{}: damaged calibration ({}); rerun `orchestrate --stage calibrate` (or "
@@ -55,8 +69,7 @@ bool read_calibrated_file(const fs::path& file, const std::string& hash, BondPar
 }  // namespace
 
 BondParams bond_params_for(const config::CaseConfig& cfg, const fs::path& run_dir) {
-  const double lambda = cfg.doc.real("lump.bond_radius_multiplier");
-  BondParams b = estimate_bond_params(cfg.ore, lambda);
+  BondParams b = estimate_bond_params(cfg.ore, cfg.doc);
   const std::string hash = ore_hash(cfg.ore);
   BondParams c = b;
   if (read_calibrated_file(run_dir / "calibrate" / "calibrated.yaml", hash, c)) return c;
@@ -74,8 +87,12 @@ std::vector<std::pair<std::string, std::string>> material_vars(const config::Doc
       {"density", num(ore.real("density"))},
       {"restitution", num(ore.real("restitution"))},
       {"friction", num(ore.real("friction"))}};
-  for (auto& kv : bond_deck_vars(b)) v.push_back(std::move(kv));
-  v.emplace_back("broken_contact", doc.boolean("lump.broken_contact") ? "yes" : "no");
+  for (auto& kv : bond_deck_vars(b)) {
+    // The parallel bond's broken contacts are the case's (lump.broken_contact).
+    if (kv.first == "bond_model_keys" && b.model == BondModel::parallel)
+      kv.second += doc.boolean("lump.broken_contact") ? " broken_contact yes" : " broken_contact no";
+    v.push_back(std::move(kv));
+  }
   return v;
 }
 

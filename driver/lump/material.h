@@ -16,12 +16,13 @@ namespace mill {
 // Hash of an ore card's macro properties (what a calibration was fitted to).
 std::string ore_hash(const config::Document& ore);
 
-// Closed-form starting estimates of the micro parameters (docs/breakage.md).
-BondParams estimate_bond_params(const config::Document& ore, double radius_multiplier);
+// Closed-form starting estimates of the micro parameters (docs/breakage.md),
+// with the case's bond model, its layout and radius multiplier (lump.*).
+BondParams estimate_bond_params(const config::Document& ore, const config::Document& doc);
 
 // The bond parameters a run uses, first found of: <run>/calibrate/calibrated.yaml,
 // the ore card's calibrated.* section (both only if fitted to this card's
-// properties), the closed-form estimates.
+// properties with the case's bond model and layout), the closed-form estimates.
 BondParams bond_params_for(const config::CaseConfig& cfg, const std::filesystem::path& run_dir);
 
 // -var pairs of the impact and lab-test decks: contacts, bonds

@@ -31,17 +31,25 @@ using namespace calibrate;
 // (git log of this line: what each version changed).
 constexpr int kDeckVersion = 4;
 
-// True when the ore card carries a complete calibrated.* section fitted to
-// its own macro properties (same input_hash).
-bool card_is_calibrated(const config::CaseConfig& cfg) {
+// True when the ore card carries a complete calibrated.* section made with
+// the case's bond model and layout (lump.bond_model, lump.joint_*): another
+// model's parameters mean nothing to this one, not even as a start.
+bool card_calibration_fits_model(const config::CaseConfig& cfg) {
   return card_has_calibration(cfg.ore) &&
+         same_model(read_calibrated(cfg.ore, BondParams{}), estimate_bond_params(cfg.ore, cfg.doc));
+}
+
+// True when the ore card carries such a section fitted to its own macro
+// properties (same input_hash).
+bool card_is_calibrated(const config::CaseConfig& cfg) {
+  return card_calibration_fits_model(cfg) &&
          cfg.ore.str(std::string(kCalibratedSection) + "." + kInputHashKey) == ore_hash(cfg.ore);
 }
 
-// True when the card carries a complete calibrated.* section fitted to other
-// properties (a stale calibration): the fit then starts from it.
+// True when the card carries such a section fitted to other properties (a
+// stale calibration): the fit then starts from it.
 bool card_has_stale_calibration(const config::CaseConfig& cfg) {
-  return card_has_calibration(cfg.ore) && !card_is_calibrated(cfg);
+  return card_calibration_fits_model(cfg) && !card_is_calibrated(cfg);
 }
 
 // Everything one calibration run needs, gathered from the case.
@@ -94,7 +102,7 @@ void Calibration::run() {
   LabBench lab(ctx_, job_.label, dir_, sp, t);
   std::vector<Iteration>& hist = o.hist;
   std::vector<std::string>& notes = o.notes;
-  BondParams p = estimate_bond_params(ore_, d_.real("lump.bond_radius_multiplier"));
+  BondParams p = estimate_bond_params(ore_, d_);
   if (card_has_stale_calibration(ctx_.cfg)) {
     // A changed card: start from its previous calibration, not from scratch.
     p = read_calibrated(ore_, p);

@@ -46,7 +46,8 @@ BondParams sample() {
 // parameters keeps its key (a new row adds one, and changes the ids).
 TEST(BondParameters, JobJsonKeysAreTheJobIdKeys) {
   const auto j = bond_json(sample(), BondNames::job);
-  EXPECT_EQ(j.size(), std::size(kBondParameters));
+  EXPECT_EQ(j.size(), std::size(kBondParameters) + 1);  // and the model
+  EXPECT_EQ(j.value("bond_model", ""), "parallel");
   const std::pair<const char*, double> pinned[] = {
       {"modulus", 18.69e9},      {"stiffness_ratio", 2.5},   {"tensile", 1.0e7},
       {"cohesion", 2.0e7},       {"friction_angle_deg", 30}, {"moment_factor", 0.5},
@@ -61,6 +62,48 @@ TEST(BondParameters, JobJsonKeysAreTheJobIdKeys) {
             1.0e7);
 }
 
+// A flat joint's JSON has its model and layout, and none of the parallel
+// bond's own rows (fix bond/flatjoint refuses their keywords).
+TEST(BondParameters, FlatJointJsonHasItsLayoutAndNoParallelRows) {
+  BondParams b = sample();
+  b.model = BondModel::flat_joint;
+  b.joint_rings = 2;
+  b.joint_sectors = 4;
+  const auto j = bond_json(b, BondNames::job);
+  EXPECT_EQ(j.value("bond_model", ""), "flat_joint");
+  EXPECT_EQ(j.value("joint_rings", 0), 2);
+  EXPECT_EQ(j.value("joint_sectors", 0), 4);
+  for (const BondParameter& p : kBondParameters)
+    EXPECT_EQ(j.contains(p.json), !p.parallel_only) << p.json;
+  EXPECT_EQ(bond_json(b, BondNames::card).value("calibrated.joint_sectors", 0), 4);
+  EXPECT_FALSE(same_model(b, sample()));
+  BondParams c = b;
+  c.joint_sectors = 3;
+  EXPECT_FALSE(same_model(b, c));
+  c.joint_sectors = 4;
+  c.cohesion *= 2;
+  EXPECT_TRUE(same_model(b, c));
+}
+
+// The decks' variables of a model: the style, the model's own keywords.
+TEST(BondParameters, DeckVariablesOfEachModel) {
+  auto value = [](const BondParams& b, const std::string& key) {
+    for (const auto& [k, v] : bond_deck_vars(b))
+      if (k == key) return v;
+    return std::string("(absent)");
+  };
+  BondParams b = sample();
+  EXPECT_EQ(value(b, "bond_style"), "breakable");
+  EXPECT_EQ(value(b, "bond_model_keys"), "moment_factor 0.5");
+  EXPECT_EQ(value(b, "moment_factor"), "(absent)");  // in bond_model_keys
+  EXPECT_EQ(value(b, "bond_tensile"), "10000000");
+  b.model = BondModel::flat_joint;
+  b.joint_rings = 1;
+  b.joint_sectors = 5;
+  EXPECT_EQ(value(b, "bond_style"), "flatjoint");
+  EXPECT_EQ(value(b, "bond_model_keys"), "elements 1 5");
+}
+
 // calibrated.yaml's map: today's lines, byte for byte and in this order, then
 // the input hash last; read back.
 TEST(BondParameters, CalibratedMapRoundTrips) {
@@ -72,7 +115,7 @@ TEST(BondParameters, CalibratedMapRoundTrips) {
   const std::string text = y.c_str();
   size_t at = 0;
   for (const char* line :
-       {"calibrated:\n", "  bond_modulus: 1.869e+10\n", "  stiffness_ratio: 2.5\n",
+       {"calibrated:\n", "  bond_model: parallel\n", "  bond_modulus: 1.869e+10\n", "  stiffness_ratio: 2.5\n",
         "  bond_tensile_strength: 10000000\n", "  bond_cohesion: 20000000\n",
         "  bond_friction_angle: 30\n", "  bond_moment_factor: 0.5\n"}) {
     const size_t found = text.find(line, at);
@@ -81,11 +124,45 @@ TEST(BondParameters, CalibratedMapRoundTrips) {
   }
   const std::string last = "\n  input_hash: abc";
   EXPECT_EQ(text.substr(text.size() - last.size()), last) << text;
-  EXPECT_EQ(text.rfind("calibrated:\n  bond_modulus:", 0), 0u) << text;
+  EXPECT_EQ(text.rfind("calibrated:\n  bond_model: parallel\n  bond_modulus:", 0), 0u) << text;
   BondParams base;
   base.radius_multiplier = 0.8;  // not fitted: kept from base
   const BondParams r = read_calibrated(YAML::Load(text)["calibrated"], base);
   EXPECT_EQ(bond_json(r, BondNames::job), bond_json(sample(), BondNames::job));
+}
+
+// A flat joint's calibration: its model and layout, no moment factor; read
+// back. A map of a flat joint without its layout is an error naming the key.
+TEST(BondParameters, FlatJointCalibratedMapRoundTrips) {
+  BondParams b = sample();
+  b.model = BondModel::flat_joint;
+  b.joint_rings = 2;
+  b.joint_sectors = 3;
+  YAML::Emitter y;
+  y.SetDoublePrecision(8);
+  y << YAML::BeginMap;
+  emit_calibrated(y, b, "abc");
+  y << YAML::EndMap;
+  const std::string text = y.c_str();
+  EXPECT_EQ(text.rfind("calibrated:\n  bond_model: flat_joint\n  joint_rings: 2\n  joint_sectors: 3\n", 0), 0u)
+      << text;
+  EXPECT_EQ(text.find("moment_factor"), std::string::npos) << text;
+  BondParams base;
+  base.radius_multiplier = 0.8;
+  const BondParams r = read_calibrated(YAML::Load(text)["calibrated"], base);
+  EXPECT_EQ(bond_json(r, BondNames::job), bond_json(b, BondNames::job));
+  try {
+    read_calibrated(YAML::Load("{bond_model: flat_joint, joint_rings: 1, bond_modulus: 1}"), BondParams{});
+    FAIL() << "no error for a missing layout";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("calibrated.joint_sectors"), std::string::npos) << e.what();
+  }
+  try {
+    read_calibrated(YAML::Load("{bond_model: glue}"), BondParams{});
+    FAIL() << "no error for an unknown model";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("calibrated.bond_model"), std::string::npos) << e.what();
+  }
 }
 
 // An optional row absent from a calibration takes its start; a required one
@@ -104,22 +181,41 @@ TEST(BondParameters, AbsentKeysOfACalibration) {
   }
 }
 
-// Every row's deck variable is declared by each deck that bonds (a default
-// that -var overrides) and passed to the style's keyword; the style reads
-// that keyword.
+// Every shared row's deck variable is declared by each deck that bonds (a
+// default that -var overrides) and passed to the style's keyword; the
+// parallel bond's own rows are in the decks' default bond_model_keys, which
+// each deck passes with the style bond/${bond_style}; the style reads every
+// keyword.
 TEST(BondParameters, EveryRowReachesTheDecksAndTheStyle) {
   const fs::path decks = kProject / "liggghts_inputs";
   const fs::path style = kProject / "liggghts_styles" / "fix_bond_breakable.cpp";
+  const char* declaring[] = {"impact.in.tmpl", "in_mill.in.tmpl", "ucs.in.tmpl",
+                             "brazilian.in.tmpl", "triaxial.in.tmpl", "scb.in.tmpl"};
+  const char* bonding[] = {"lump_bonds.in", "ucs.in.tmpl", "brazilian.in.tmpl",
+                           "triaxial.in.tmpl", "scb.in.tmpl"};
+  for (const char* deck : declaring)
+    for (const char* v : {"bond_style", "bond_model_keys"})
+      EXPECT_NE(slurp(decks / deck).find(std::string("variable ") + v + " "), std::string::npos)
+          << deck << " does not declare " << v;
+  for (const char* deck : bonding) {
+    EXPECT_NE(slurp(decks / deck).find("fix bonds all bond/${bond_style} "), std::string::npos)
+        << deck;
+    EXPECT_NE(slurp(decks / deck).find(" ${bond_model_keys} "), std::string::npos) << deck;
+  }
   for (const BondParameter& p : kBondParameters) {
-    for (const char* deck :
-         {"impact.in.tmpl", "in_mill.in.tmpl", "ucs.in.tmpl", "brazilian.in.tmpl"}) {
-      EXPECT_NE(slurp(decks / deck).find(std::string("variable ") + p.deck + " "),
-                std::string::npos)
-          << deck << " does not declare " << p.deck;
-    }
-    const std::string passed = std::string(p.keyword) + " ${" + p.deck + "}";
-    for (const char* deck : {"lump_bonds.in", "ucs.in.tmpl", "brazilian.in.tmpl"}) {
-      EXPECT_NE(slurp(decks / deck).find(passed), std::string::npos) << deck << ": " << passed;
+    if (p.parallel_only) {
+      for (const char* deck : declaring)
+        EXPECT_NE(slurp(decks / deck).find(std::string("bond_model_keys  index \"") + p.keyword),
+                  std::string::npos)
+            << deck << ": " << p.keyword << " not in the default bond_model_keys";
+    } else {
+      for (const char* deck : declaring)
+        EXPECT_NE(slurp(decks / deck).find(std::string("variable ") + p.deck + " "),
+                  std::string::npos)
+            << deck << " does not declare " << p.deck;
+      const std::string passed = std::string(p.keyword) + " ${" + p.deck + "}";
+      for (const char* deck : bonding)
+        EXPECT_NE(slurp(decks / deck).find(passed), std::string::npos) << deck << ": " << passed;
     }
     if (fs::exists(style)) {
       EXPECT_NE(slurp(style).find(std::string("key == \"") + p.keyword + "\""), std::string::npos)

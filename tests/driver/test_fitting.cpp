@@ -138,3 +138,26 @@ TEST(Fitting, SmallGapUsesTheCohesion) {
   EXPECT_EQ(p.friction_angle_deg, 30.0);
   EXPECT_GT(p.cohesion / p.tensile, 2.0);
 }
+
+// Flat joints: neither coarse lever moves (the elements carry the moments
+// whole; the friction angle is also the broken elements' friction); the
+// cohesion ratio takes one damped step of the flat joint's first slope 0.5:
+// UCS/T 5 against 10 wants ln 2 / 0.5 = ln 4, capped at x 3.
+TEST(Fitting, FlatJointMovesTheCohesionAlone) {
+  const Fitting fit(kCard, 0.1);
+  BondParams p0 = start();
+  p0.model = BondModel::flat_joint;
+  std::vector<Iteration> hist{made(p0, 18.69e9, 0.18, 25e6, 5e6)};
+  fit.score(hist.back());
+  std::vector<std::string> notes;
+  const BondParams p = fit.update(hist, notes);
+  EXPECT_EQ(p.model, BondModel::flat_joint);
+  EXPECT_EQ(p.moment_factor, 1.0);
+  EXPECT_EQ(p.friction_angle_deg, 30.0);
+  EXPECT_NEAR(p.cohesion / p.tensile, 2.0 * 3.0, 1e-9);
+  // A smaller gap: ratio 8 against 10 -> x (10/8)^(1/0.5), below the cap.
+  std::vector<Iteration> near{made(p0, 18.69e9, 0.18, 40e6, 5e6)};
+  fit.score(near.back());
+  const BondParams q = fit.update(near, notes);
+  EXPECT_NEAR(q.cohesion / q.tensile, 2.0 * 1.25 * 1.25, 1e-9);
+}

@@ -77,7 +77,12 @@ BondParams Fitting::update(const std::vector<Iteration>& hist,
   if (now.err_E <= tol_ && now.err_t <= tol_ && post::RelativeError(have, want) > tol_) {
     // The moment factor and friction-angle moves are coarse (each raised the
     // ratio by ~20 %): used only for a gap larger than that, else the cohesion.
-    const bool far_below = have * kCoarseLeverGap < want;
+    // A flat joint has neither coarse lever: its elements carry the moments
+    // whole, and its friction angle is also its broken elements' friction;
+    // its lever is the cohesion (bench/README.md, "Strength ratio:
+    // coordination and cohesion with the flat joint").
+    const bool far_below =
+        have * kCoarseLeverGap < want && now.p.model == BondModel::parallel;
     if (far_below && p.moment_factor > 0.0) {
       p.moment_factor = 0.0;
       notes.push_back(
@@ -89,7 +94,12 @@ BondParams Fitting::update(const std::vector<Iteration>& hist,
           "iteration {}: UCS/tensile {:.2f} (card {:.1f}): bond friction angle {:g} -> {:g} deg",
           hist.size(), have, want, now.p.friction_angle_deg, kMaxFrictionAngle));
     } else {
-      const post::SecantRule c_rule{true, 1.0, 0.5, 2.0, std::log(2.0)};
+      // The ratio's slope in log space: about 1 for the parallel bond; 0.35-0.56
+      // for the flat joint at coordination 10 (c/sigma_c 5 -> 10 -> 20 gave
+      // 7.59 -> 9.68 -> 14.27; bench/README.md), so a wider step there.
+      const bool fj = now.p.model == BondModel::flat_joint;
+      const post::SecantRule c_rule{true, fj ? 0.5 : 1.0, fj ? 0.25 : 0.5, 2.0,
+                                    std::log(fj ? 3.0 : 2.0)};
       const bool prev_moved =
           prev && std::abs(std::log(prev->p.cohesion / prev->p.tensile / ratio_now)) > 1e-6;
       ratio = post::SecantUpdate(c_rule, pt(ratio_now, have),

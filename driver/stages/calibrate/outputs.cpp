@@ -135,8 +135,22 @@ std::vector<std::string> Report::explain_missed() const {
     double best_ratio = 0.0;
     for (const auto& it : hist_)
       best_ratio = std::max(best_ratio, it.ucs.r.ucs / it.br.r.tensile_strength);
+    const bool fj = b_.p.model == BondModel::flat_joint;
     missed.push_back(
-        post::RelativeError(ratio, want) > tol_
+        post::RelativeError(ratio, want) > tol_ && fj
+            ? fmt::format(
+                  "UCS {:.1f} MPa is {:.0f}% off the target: UCS/tensile reached {:.1f} against "
+                  "{:.1f} on the card (at most {:.1f} over the {} iterations). With flat joints ({}) "
+                  "the fit moves one lever for the ratio, the cohesion ratio (now {:.2f}{}); it rises "
+                  "with the coordination (interfaces per element, set by lump.bond_gap), so a "
+                  "wider bond gap or more iterations (calibrate.max_iterations) may reach it "
+                  "(bench/README.md, \"Strength ratio: coordination and cohesion with the flat "
+                  "joint\"){}",
+                  b_.ucs.r.ucs / 1e6, 100 * b_.err_ucs, ratio, want, best_ratio, hist_.size(),
+                  bond_model_text(b_.p), b_.p.cohesion / b_.p.tensile,
+                  b_.p.cohesion / b_.p.tensile >= kMaxCohesionRatio * 0.999 ? ", at its cap" : "",
+                  lever)
+        : post::RelativeError(ratio, want) > tol_
             ? fmt::format(
                   "UCS {:.1f} MPa is {:.0f}% off the target: UCS/tensile reached {:.1f} against "
                   "{:.1f} on the card (at most {:.1f} over the {} iterations). Bonded sphere "
@@ -294,12 +308,15 @@ std::string Report::markdown() const {
                     b_.err_t <= tol_ ? "yes" : "no");
   md << "## Bond parameters (calibrated.yaml)\n\n| parameter | value |\n|---|---|\n";
   md << fmt::format(
-      "| bond modulus (GPa) | {:.3f} |\n| kn/ks | {:.3f} |\n| bond tensile strength (MPa) | {:.3f} "
-      "|\n"
-      "| bond cohesion (MPa) | {:.3f} |\n| bond friction angle (deg) | {:.1f} |\n| moment "
-      "factor | {:g} |\n| radius multiplier | {:g} |\n\n",
-      b_.p.modulus / 1e9, b_.p.stiffness_ratio, b_.p.tensile / 1e6, b_.p.cohesion / 1e6,
-      b_.p.friction_angle_deg, b_.p.moment_factor, b_.p.radius_multiplier);
+      "| bond model (lump.bond_model) | {} |\n| bond modulus (GPa) | {:.3f} |\n| kn/ks | {:.3f} "
+      "|\n| bond tensile strength (MPa) | {:.3f} |\n"
+      "| bond cohesion (MPa) | {:.3f} |\n| bond friction angle (deg) | {:.1f} |\n{}| radius "
+      "multiplier | {:g} |\n\n",
+      bond_model_text(b_.p), b_.p.modulus / 1e9, b_.p.stiffness_ratio, b_.p.tensile / 1e6,
+      b_.p.cohesion / 1e6, b_.p.friction_angle_deg,
+      b_.p.model == BondModel::parallel ? fmt::format("| moment factor | {:g} |\n", b_.p.moment_factor)
+                                        : std::string(),
+      b_.p.radius_multiplier);
   md << "## Iterations\n\n| it | E_b (GPa) | kn/ks | sigma_b (MPa) | c (MPa) | phi (deg) | beta | "
         "E (GPa) | nu | UCS (MPa) | tensile (MPa) | UCS/tensile | "
         "wall (s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
