@@ -1,0 +1,163 @@
+// The virtual triaxial test on a fixed material (fixed bond parameters, no
+// calibration) with real LIGGGHTS runs, through the calibrate stage's own
+// code: the specimen packed and carved as the stage does
+// (calibrate::pack_specimen), each confinement run by calibrate::LabBench's
+// triaxial test (liggghts_inputs/triaxial.in.tmpl, analysed by
+// post::AnalyseTriaxial), the envelope fitted by post::FitMohrCoulomb.
+// Issue 28: "A triaxial test on a fixed material gives a peak stress on the
+// Mohr-Coulomb line that its own two confinements define, within 5 %."
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "config/case_config.h"
+#include "e2e_util.h"
+#include "engine/runner.h"
+#include "lump/material.h"
+#include "postprocess/lab_tests.h"
+#include "progress.h"
+#include "stages/calibrate/lab_runs.h"
+#include "stages/calibrate/specimen.h"
+#include "stages/stage.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using namespace mill;
+using namespace mill::e2e;
+
+// The specimen: 300 elements of the size of a 150-element, 20 mm lump (as in
+// the tests' tiny calibration, tests/data/tiny_calibrate.yaml), carved from a
+// ball packed with seed 2003 (1350 elements), loaded at the calibrate stage's
+// default strain rate. Packing and the three runs took 46 s on one core.
+constexpr long kElements = 300;
+constexpr double kStrainRate = 0.5;  // 1/s
+
+// The fixed material: the sandstone card's contacts and the bond parameters
+// of the default case's signed-criterion fit (bench/README.md, "Rock
+// strength levers": E_b 67.99 GPa, kn/ks 4.02, sigma_b 30.69 MPa, c 61.39 MPa,
+// phi 30 deg), no calibration.
+BondParams fixed_bonds(const config::CaseConfig& cfg) {
+  BondParams b = estimate_bond_params(cfg.ore, cfg.doc.real("lump.bond_radius_multiplier"));
+  b.modulus = 67.99e9;
+  b.stiffness_ratio = 4.02;
+  b.tensile = 30.694e6;
+  b.cohesion = 61.389e6;
+  b.friction_angle_deg = 30.0;
+  b.moment_factor = 1.0;
+  b.origin = "fixed (test_triaxial_e2e)";
+  return b;
+}
+
+// The confining pressures, Pa: none (the UCS test), then 0.1 and 0.2 x the
+// material's UCS (about 25 MPa), the calibrate stage's default
+// calibrate.confining_pressures. Up to about UCS/4 the bonded packing
+// follows Mohr-Coulomb (docs/calibration.md, "Virtual triaxial test": on the
+// default 400-element specimen the line through any two peaks at sigma_3
+// 0-5 MPa predicted the others within 3.8 %; the peak at 10 MPa, about
+// UCS/2, lay 22 % below the line), which is why the calibrate stage confines
+// at 0.1 and 0.2 x UCS.
+const std::vector<double> kPressures = {0.0, 2.5e6, 5.0e6};
+
+TEST(TriaxialEnvelope, MiddlePeakLiesOnTheMohrCoulombLineOfTheOuterConfinements) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const fs::path dir = scratch("triaxial");
+  spit(dir / "case.yaml", fmt::format("name: triaxial_envelope\nore: {{card: sandstone}}\n"
+                                      "lump: {{n_elements: 150, diameter: 0.02, bond_gap: 0.2}}\n"
+                                      "calibrate: {{n_elements: {}, strain_rate: {}, seed: 2003}}\n"
+                                      "resources: {{np: 1, jobs: 1}}\n",
+                                      kElements, kStrainRate));
+  setenv("MILL_LIGGGHTS", LIGGGHTS_MILL_EXE, 1);
+  const config::CaseConfig cfg = config::load_case(dir / "case.yaml", MILL_PROJECT_DIR);
+  RunOptions opts;
+  opts.output = dir;
+  engine::Runner runner;
+  std::ofstream progress_log(dir / "progress.log");
+  Progress progress(progress_log, false);
+  StageContext ctx{cfg, opts, dir, dir / "calibrate", runner, progress};
+
+  const calibrate::Specimen sp = calibrate::pack_specimen(ctx, "triaxial", dir, kElements);
+  // The targets only size each run (its strain cap and sampling interval);
+  // the UCS here is about the material's (25 MPa), not the card's 50.
+  const calibrate::Targets targets{cfg.ore.real("youngs_modulus"), cfg.ore.real("poisson_ratio"),
+                                   25e6, cfg.ore.real("tensile_strength")};
+  calibrate::LabBench lab(ctx, "triaxial", dir, sp, targets);
+  const BondParams bonds = fixed_bonds(cfg);
+
+  std::vector<calibrate::TriaxialRun> runs;
+  std::string table;
+  for (size_t k = 0; k < kPressures.size(); ++k) {
+    const std::string tag = fmt::format("triaxial_{}", k + 1);
+    runs.push_back(lab.triaxial(bonds, kStrainRate, kPressures[k],
+                                {tag, fmt::format("triaxial at {:.3g} MPa", kPressures[k] / 1e6),
+                                 static_cast<double>(k) / kPressures.size()}));
+    const post::TriaxialResult& r = runs.back().r;
+    table += fmt::format(
+        "  {}: p {:.3f} MPa, sigma_3 {:.3f} MPa, sigma_1 {:.3f} MPa at strain {:.5f}, "
+        "{} bonds broken by the confinement, {:.1f} s\n",
+        tag, kPressures[k] / 1e6, r.sigma3 / 1e6, r.sigma1 / 1e6, r.strain_at_peak,
+        r.broken_before_loading, runs.back().seconds);
+  }
+  const post::TriaxialResult &lo = runs[0].r, &mid = runs[1].r, &hi = runs[2].r;
+
+  // Each run peaked (it did not reach its strain cap still loading), under
+  // the confinement asked: sigma_3 at the peak is the confining force the
+  // deck applied over the lateral area, so a deck that dropped or mis-scaled
+  // the confinement fails here. The follower forces keep it within a few
+  // per cent as the specimen bulges; 10 % as the calibrate e2e test allows.
+  for (size_t k = 0; k < runs.size(); ++k) {
+    EXPECT_TRUE(runs[k].peaked) << runs[k].tag << "\n" << table;
+    if (kPressures[k] > 0)
+      EXPECT_NEAR(runs[k].r.sigma3 / kPressures[k], 1.0, 0.1) << runs[k].tag << "\n" << table;
+    else
+      EXPECT_EQ(runs[k].r.sigma3, 0.0) << table;
+    // The confinement alone broke no bond: the peaks are those of the intact
+    // material, whose envelope the line is.
+    EXPECT_EQ(runs[k].r.broken_before_loading, 0.0) << runs[k].tag << "\n" << table;
+  }
+
+  // The peak must rise with the confinement by more than the confinement
+  // itself: q = d sigma_1 / d sigma_3 > 1 is a positive friction angle. A
+  // deck whose confinement only added sigma_3 to the axial stress without
+  // strengthening the specimen (the same deviator at every confinement:
+  // q = 1) would put the middle peak on its line too; this rules it out. The
+  // bonded packing gave q 2.87 (phi 28.9 deg) on the default specimen and
+  // 2.46 (phi 24.9 deg) here; q >= 1.5 (phi >= 11.5 deg) leaves room for
+  // the packing's scatter and admits no confinement without effect.
+  const double q = (hi.sigma1 - lo.sigma1) / (hi.sigma3 - lo.sigma3);
+  ASSERT_GE(q, 1.5) << table;
+  // The Mohr-Coulomb line sigma_1 = UCS_mc + q sigma_3 through the outer two
+  // confinements (FitMohrCoulomb is exact through two points).
+  const post::MohrCoulomb mc =
+      post::FitMohrCoulomb({{lo.sigma3, lo.sigma1}, {hi.sigma3, hi.sigma1}});
+  // The middle confinement is an interpolation: its peak lies on the line
+  // within 5 % (issue 28). Basis: on the default 400-element specimen the
+  // line through any two peaks up to UCS/4 predicted the others within
+  // 3.8 %; this specimen gave +0.57 % (+0.97 % at 2 1/s). The line's own
+  // peaks carry the scatter of a few hundred elements, so a tighter bound
+  // would test the packing's noise rather than the envelope; the 22 % by
+  // which the envelope bends at UCS/2 is far outside it.
+  const double predicted = mc.Sigma1(mid.sigma3);
+  const double deviation = mid.sigma1 / predicted - 1.0;
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::string summary = fmt::format(
+      "{}line: UCS_mc {:.3f} MPa, q {:.3f} (phi {:.1f} deg, c {:.3f} MPa); middle peak "
+      "{:.3f} MPa against {:.3f} MPa on the line: {:+.2f} %; specimen {} elements "
+      "(cylinder radius {:.2f} mm), {:.0f} s in all",
+      table, mc.ucs / 1e6, mc.q, mc.friction_angle_deg, mc.cohesion / 1e6, mid.sigma1 / 1e6,
+      predicted / 1e6, 100 * deviation, kElements, sp.cyl_r * 1e3, seconds);
+  EXPECT_LE(std::abs(deviation), 0.05) << summary;
+  std::cout << summary << "\n";
+  if (!HasFailure()) fs::remove_all(dir);  // kept for a look when the test fails
+}
+
+}  // namespace
