@@ -46,7 +46,7 @@ constexpr double kStrainRate = 0.5;  // 1/s
 // strength levers": E_b 67.99 GPa, kn/ks 4.02, sigma_b 30.69 MPa, c 61.39 MPa,
 // phi 30 deg), no calibration.
 BondParams fixed_bonds(const config::CaseConfig& cfg) {
-  BondParams b = estimate_bond_params(cfg.ore, cfg.doc.real("lump.bond_radius_multiplier"));
+  BondParams b = estimate_bond_params(cfg.ore, cfg.doc);
   b.modulus = 67.99e9;
   b.stiffness_ratio = 4.02;
   b.tensile = 30.694e6;
