@@ -44,35 +44,26 @@ mean_r=$(awk '{for (i = 1; i < NF; ++i) if ($i == "mean_radius") print $(i + 1)}
 mkdir -p "$out"
 out="$(cd "$out" && pwd)"
 
-# The deck with its fix bond/breakable block swapped for the model's line.
-make_deck() {  # deck model -> file
-  /usr/bin/python3 - "$root/liggghts_inputs/$1.in.tmpl" "$2" "$elements" "$joint_friction" "$fj_extra" "$bond_extra" <<'PY'
-import re, sys
-deck, model, elements, mu, extra, both = sys.argv[1:7]
-text = open(deck).read()
-block = re.search(r"^fix bonds all bond/breakable .*?(?<!&)\n", text, re.S | re.M)
-if model == "flatjoint":
-    line = ("fix bonds all bond/flatjoint modulus ${bond_modulus} stiffness_ratio ${stiffness_ratio} &\n"
-            "    tensile_strength ${bond_tensile} cohesion ${bond_cohesion} friction_angle ${bond_friction} &\n"
-            "    radius_multiplier ${radius_mult} elements " + elements +
-            ("" if float(mu) < 0 else " joint_friction " + mu) +
-            (" " + extra if extra else "") +
-            " unbonded_fraction ${unbonded_frac} gap ${bond_gap} max_bonds ${max_bonds}"
-            " damping ${bond_damping}\n")
-else:
-    line = block.group(0)
-if both:
-    line = line.rstrip("\n") + " " + both + "\n"
-text = text[:block.start()] + line + text[block.end():]
-sys.stdout.write(text)
-PY
+# The model's keywords (the decks' fix line is bond/${bond_style} with the
+# model's own keywords in ${bond_model_keys}; docs/calibration.md, "The bond
+# model").
+model_keys() {  # model -> keywords
+  if [ "$1" = flatjoint ]; then
+    k="elements $elements"
+    awk "BEGIN{exit !($joint_friction >= 0)}" && k="$k joint_friction $joint_friction"
+    [ -n "$fj_extra" ] && k="$k $fj_extra"
+  else
+    k="moment_factor $moment_factor broken_contact no contact_moment no"
+  fi
+  [ -n "$bond_extra" ] && k="$k $bond_extra"
+  echo "$k"
 }
 
 # test carve_r peak_strain cap model
 run_test() {
   dir="$out/$4/$1"
   mkdir -p "$dir"
-  make_deck "$1" "$4" > "$dir/$1.in"
+  cp "$root/liggghts_inputs/$1.in.tmpl" "$dir/$1.in"
   peak=$3
   (cd "$dir" && "$exe" -in "$1.in" -log liggghts.log -screen none \
       -var specimen_file "$spec/ball.data" -var carve_r "$2" -var strain_rate "$rate" \
@@ -83,7 +74,8 @@ run_test() {
       -var friction "$friction" -var bond_modulus "$bond_modulus" \
       -var stiffness_ratio "$stiffness_ratio" -var bond_tensile "$bond_tensile" \
       -var bond_cohesion "$bond_cohesion" -var bond_friction "$bond_friction" \
-      -var moment_factor "$moment_factor" -var radius_mult "$radius_mult" \
+      -var bond_style "$( [ "$4" = flatjoint ] && echo flatjoint || echo breakable )" \
+      -var bond_model_keys "$(model_keys "$4")" -var radius_mult "$radius_mult" \
       -var bond_gap "$bond_gap" -var max_bonds "$max_bonds" -var unbonded_frac "$unbonded_frac") ||
     { echo "strength_ratio: $4 $1 failed: see $dir/liggghts.log" >&2; exit 1; }
 }
