@@ -829,6 +829,7 @@ void FixBondBreakable::evaluate_flat_joint(const AtomArrays &at, ListedBond &bon
   st.stretch = len - bond.l0;
   st.gap0 = bond.gap0;
   st.advance = advance;
+  st.stresses = false;  // the largest stresses go to the break log only
   mill::flat_joint::Params p;
   p.kn = bond.kna * bond.inv_area;
   p.ks = bond.ksa * bond.inv_area;
