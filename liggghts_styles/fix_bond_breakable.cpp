@@ -890,6 +890,7 @@ void FixBondBreakable::store_history() {
     store3(&si[MB], load3(lb.mb));
     si[MT] = lb.mt;
     si[STATE] = lb.state;
+    if (lb.fj) std::memcpy(&si[NCOL], lb.fj, (ncol_ - NCOL) * sizeof(double));
     if (lb.j >= 0) std::memcpy(&bonds_[lb.j][lb.slot_j * ncol_ + FS], &si[FS],
                                (ncol_ - FS) * sizeof(double));
   }
@@ -963,9 +964,23 @@ void FixBondBreakable::build_bond_list() {
       lb.cn = 2.0 * damping_ * std::sqrt(ma * mbm / (ma + mbm) * kn * area);
       lb.cs = lb.cn * std::sqrt(inv_ratio_);
       lb.drop_len = slot[L0] + gap_ * std::min(radius[lb.a], radius[lb.b]);
-      lb.fj = flat_joint_ ? &bonds_[i][k * ncol_ + NCOL] : nullptr;
+      lb.fj = nullptr;  // bond/flatjoint: set below
       lb.gap0 = std::max(0.0, slot[L0] - radius[lb.a] - radius[lb.b]);
       list_.push_back(lb);
+    }
+  }
+  // bond/flatjoint: the interfaces' histories copied into one array in list
+  // order, which the loop then reads as a stream. Read in their slots, each
+  // interface's history sat in its atom's row of max_bonds slots (a row
+  // longer than a page) and cost a cache miss: half of the flat joint's
+  // time in perf.
+  if (flat_joint_) {
+    const size_t hs = static_cast<size_t>(ncol_ - NCOL);
+    fj_history_.resize(list_.size() * hs);
+    for (size_t e = 0; e < list_.size(); ++e) {
+      ListedBond &lb = list_[e];
+      lb.fj = &fj_history_[e * hs];
+      std::memcpy(lb.fj, &bonds_[lb.i][lb.slot_i * ncol_ + NCOL], hs * sizeof(double));
     }
   }
   list_valid_ = true;
