@@ -66,7 +66,7 @@ double slip_loss(const ElementLoad &trial, const ElementLoad &kept, double prev1
 // t1 - (s . t1) / (1 + n0 . n1) s: the same rotation in half the
 // operations. Then the spin: t1 cos + (n1 x t1) sin (sin_cos). Rotations
 // keep t1 unit and normal to n1 up to round-off; carry (the end of a step)
-// removes that round-off, the midpoint's turn needs not.
+// removes that round-off; the midpoint's turn does without it.
 [[gnu::always_inline]] inline Vec3 turn(Vec3 t1, Vec3 n0, Vec3 n1, double spin) {
   const Vec3 s = n0 + n1;
   t1 = t1 - (dot(s, t1) / (1.0 + dot(n0, n1))) * s;
@@ -198,7 +198,7 @@ Result update(double *h, const Layout &lay, const Params &p, const Step &s) {
     ElementLoad before;
     const bool bonded = el[kState] == 0.0;
     if (bonded) {
-      const double sigma = kn * u;  // N_e / A_e
+      const double sigma = kn * u;                         // N_e / A_e
       const double strength = cohesion - sigma * tan_phi;  // Mohr-Coulomb, tension > 0
       // tau > tau_c  <=>  |S|^2 > (tau_c A_e)^2 for tau_c > 0; always for
       // tau_c < 0; for tau_c = 0 once any shear is left.

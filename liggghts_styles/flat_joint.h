@@ -42,9 +42,9 @@ inline constexpr int kMaxElements = 32;
 // intact, it is as stiff as the parallel bond of the same radius.
 struct Layout {
   int nr = 1, na = 3;
-  std::vector<double> area;  // A_e / A  (sums to 1)
-  std::vector<double> px;    // in-plane position / R along t1
-  std::vector<double> py;    // in-plane position / R along t2
+  std::vector<double> area;      // A_e / A  (sums to 1)
+  std::vector<double> px;        // in-plane position / R along t1
+  std::vector<double> py;        // in-plane position / R along t2
   std::vector<double> inv_area;  // A / A_e: the element loop multiplies, never divides
   int elements() const { return nr * na; }
 };
@@ -135,8 +135,9 @@ struct SinCos {
 SinCos turn_sin_cos(double a);
 
 // The frame's reference axis t1 (unit, normal to n0) carried from the
-// normal n0 to n1 and turned by `spin` about n1 (the carry update() makes twice a step): exposed for the
-// tests of its series branch.
+// normal n0 to n1 and turned by `spin` about n1, unit and normal to n1
+// again (update() carries its frame so, in two halves, each step): exposed
+// for the tests of its rotation and series branch.
 Vec3 carry(Vec3 t1, Vec3 n0, Vec3 n1, double spin);
 
 // Stiffnesses of the intact interface, for the critical time step: normal
