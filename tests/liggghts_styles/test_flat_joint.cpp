@@ -2,7 +2,8 @@
 // forms: layout, break loads of the elements in tension and in shear, the
 // moment of a partly broken interface, the rolling resistance of a fully
 // broken one, objectivity under rigid rotation, the stiffnesses that set the
-// critical time step, and the energy of a loading path.
+// critical time step, the energy of a loading path, and the frame carry
+// (its series sin/cos for small turns) against the exact rotation.
 #include <gtest/gtest.h>
 
 #include <cmath>
