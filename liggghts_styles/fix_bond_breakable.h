@@ -170,9 +170,11 @@ class FixBondBreakable : public Fix {
     double cn, cs;                        // dashpots (damping > 0) [N s/m]
     double drop_len;                      // a contact is dropped beyond this length [m]
     double gap0;                          // flat joint: installation gap, >= 0 [m]
-    double *fj;  // bond/flatjoint: the interface's history, in i's slot (mirrored by store_history)
+    double *fj;  // bond/flatjoint: the interface's history, in fj_history_ (written
+                 // back to the slots by store_history)
   };
   std::vector<ListedBond> list_;
+  std::vector<double> fj_history_;  // bond/flatjoint: the listed interfaces' histories
   bool list_valid_ = false;
   bool history_dirty_ = false;  // list_ holds history not yet in the slots
   bigint list_ncalls_ = -1;     // neighbor->ncalls when the list was built

@@ -42,9 +42,10 @@ inline constexpr int kMaxElements = 32;
 // intact, it is as stiff as the parallel bond of the same radius.
 struct Layout {
   int nr = 1, na = 3;
-  std::vector<double> area;  // A_e / A  (sums to 1)
-  std::vector<double> px;    // in-plane position / R along t1
-  std::vector<double> py;    // in-plane position / R along t2
+  std::vector<double> area;      // A_e / A  (sums to 1)
+  std::vector<double> px;        // in-plane position / R along t1
+  std::vector<double> py;        // in-plane position / R along t2
+  std::vector<double> inv_area;  // A / A_e: the element loop multiplies, never divides
   int elements() const { return nr * na; }
 };
 // Throws std::invalid_argument for nr < 1, na < 3 or nr x na > kMaxElements.
@@ -96,6 +97,8 @@ struct Step {
                       // was made, >= 0 [m]; a broken element touches once the
                       // opening stretch + gap0 is below zero
   bool advance = true;  // false: evaluate only (no increment, no break)
+  bool stresses = true; // false: Result::sigma_max and tau_ratio only on a step with a
+                        // break (when a break log wants them); 0 on the others
 };
 
 // What the interface does to the pair at the end of the step.
@@ -108,7 +111,8 @@ struct Result {
   int bonded = 0;       // bonded elements after the step
   int broke_tension = 0, broke_shear = 0;  // elements that broke this step
   // Over the elements bonded at the start of the step (those that broke in
-  // it at their stress at the break):
+  // it at their stress at the break; with Step::stresses false, on a step
+  // with a break only):
   double sigma_max = 0;  // largest normal stress (tension > 0) [Pa]
   double tau_ratio = 0;  // largest shear stress / shear strength [-]
   bool loaded = false;   // some element carries force (bonded, or broken and pressed)
@@ -116,6 +120,25 @@ struct Result {
 
 // Advances (step.advance) and evaluates the interface whose history is h.
 Result update(double *h, const Layout &lay, const Params &p, const Step &step);
+
+// sin and cos of the small turns the frame makes in one step. Below
+// kSeriesTurn (|a| < 1e-3 rad; an impact's steps turn a pair by ~1e-5 rad)
+// they are the Taylor series a - a^3/3! + a^5/5! and 1 - a^2/2! + a^4/4!,
+// whose truncation errors, below a^7/7! and a^6/6!, are under 2e-22 of
+// sin a and 1.4e-21 of cos a there: far below a double's round-off
+// (1.1e-16), so the series is the exact value to round-off at a fraction of
+// the cost of the library's sin and cos, which it uses above the switch.
+inline constexpr double kSeriesTurn = 1.0e-3;
+struct SinCos {
+  double sin, cos;
+};
+SinCos turn_sin_cos(double a);
+
+// The frame's reference axis t1 (unit, normal to n0) carried from the
+// normal n0 to n1 and turned by `spin` about n1, unit and normal to n1
+// again (update() carries its frame so, in two halves, each step): exposed
+// for the tests of its rotation and series branch.
+Vec3 carry(Vec3 t1, Vec3 n0, Vec3 n1, double spin);
 
 // Stiffnesses of the intact interface, for the critical time step: normal
 // and shear [N/m], bending and twisting [N m/rad]. Equal to the parallel

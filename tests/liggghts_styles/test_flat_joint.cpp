@@ -2,7 +2,8 @@
 // forms: layout, break loads of the elements in tension and in shear, the
 // moment of a partly broken interface, the rolling resistance of a fully
 // broken one, objectivity under rigid rotation, the stiffnesses that set the
-// critical time step, and the energy of a loading path.
+// critical time step, the energy of a loading path, and the frame carry
+// (its series sin/cos for small turns) against the exact rotation.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -309,4 +310,51 @@ TEST(FlatJoint, WorkOfALoadingPathIsTheStoredEnergy) {
   }
   EXPECT_LT(prev.energy, 1e-12 * loaded);
   EXPECT_LT(std::fabs(work), 1e-6 * loaded);
+}
+
+// The frame's small turns take their sin and cos from a Taylor series below
+// kSeriesTurn (flat_joint.h: truncation error < 2e-22 relative there): it
+// agrees with the library's sin and cos to round-off at every angle a step
+// makes, and above the switch it is the library's.
+TEST(FlatJoint, SmallTurnSeriesIsTheExactSinAndCos) {
+  const double eps = 2.3e-16;  // about one ulp: the series' own rounding
+  for (double a : {1e-12, 3e-9, 1e-7, 2.5e-6, 1e-5, 7e-5, 3e-4, 9.99e-4}) {
+    for (double sg : {1.0, -1.0}) {
+      const SinCos sc = turn_sin_cos(sg * a);
+      EXPECT_NEAR(sc.sin, std::sin(sg * a), eps * std::fabs(std::sin(a))) << sg * a;
+      EXPECT_NEAR(sc.cos, std::cos(sg * a), eps) << sg * a;
+    }
+  }
+  for (double a : {1e-3, 0.2, -3.0}) {
+    const SinCos sc = turn_sin_cos(a);
+    EXPECT_EQ(sc.sin, std::sin(a));
+    EXPECT_EQ(sc.cos, std::cos(a));
+  }
+}
+
+// The frame carry (a turn of the normal and a spin about it, as in one
+// step) against the same rotations written out with the library's sin and
+// cos: equal to round-off at the small angles of a step (series branch) and
+// at large ones (library branch).
+TEST(FlatJoint, FrameCarryIsTheExactRotation) {
+  // v turned by angle about the unit axis k (Rodrigues' rotation formula).
+  auto rotate = [](Vec3 v, Vec3 k, double angle) {
+    const double c = std::cos(angle), s = std::sin(angle);
+    return c * v + s * cross(k, v) + ((1.0 - c) * dot(k, v)) * k;
+  };
+  auto unit = [](Vec3 v) { return (1.0 / std::sqrt(dot(v, v))) * v; };
+  const Vec3 n0 = unit(Vec3{0.3, -0.5, 0.81});
+  const Vec3 t0 = unit(cross(n0, Vec3{1, 0, 0}));
+  for (double turn : {2e-6, 4e-5, 6e-4, 0.3}) {
+    for (double spin : {0.0, 1e-7, -3e-5, 9e-4, 0.25}) {
+      const Vec3 axis = unit(cross(n0, Vec3{0.2, 0.9, -0.1}));
+      const Vec3 n1 = rotate(n0, axis, turn);
+      const Vec3 got = carry(t0, n0, n1, spin);
+      const Vec3 want = rotate(rotate(t0, axis, turn), n1, spin);
+      for (double d : {got.x - want.x, got.y - want.y, got.z - want.z})
+        EXPECT_NEAR(d, 0.0, 1e-15) << "turn " << turn << " spin " << spin;
+      EXPECT_NEAR(dot(got, n1), 0.0, 4e-16);
+      EXPECT_NEAR(dot(got, got), 1.0, 1e-15);
+    }
+  }
 }
