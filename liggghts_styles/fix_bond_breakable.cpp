@@ -1060,7 +1060,7 @@ void FixBondBreakable::compute_bonds(bool advance) {
     apply(lb);
     if (lb.state == 0.0 && r.fj_bonded == 0) contact_.push_back(e);  // all elements broken
     if (!lb.i_lower) continue;  // counted once: by the owner of the lower tag
-    stored += r.energy;
+    local[3] += r.energy;  // output 5: the energy in the elements, bonded or pressed
     ledger_.friction += r.slipped;
     ledger_.released += r.released;
     if (damping_ > 0.0) store3(&dash_[3 * e], r.fdash);

@@ -68,7 +68,7 @@ TEST(BondPair, AxialOscillationPeriod) {
 }
 
 // Runs a pair whose atom 2 is moved at velocity (vx, vy, 0) with atom 1 held;
-// returns the fix print rows (t |F2| intact tension shear).
+// returns the fix print rows (t |F2| intact tension shear energy).
 // `fix` replaces the bond/breakable line (e.g. flat_joint_fix()).
 std::vector<std::vector<double>> run_prescribed_pair(const std::string &dir, double vx, double vy,
                                                      int steps, double dt,
@@ -83,8 +83,9 @@ std::vector<std::vector<double>> run_prescribed_pair(const std::string &dir, dou
     << "variable t equal time\n"
     << "variable f2 equal sqrt(fx[2]^2+fy[2]^2+fz[2]^2)\n"
     << "variable nb equal f_bonds[1]\nvariable nt equal f_bonds[3]\nvariable ns equal "
-       "f_bonds[4]\n"
-    << "fix pr all print 1 \"${t} ${f2} ${nb} ${nt} ${ns}\" file force.txt screen no title none\n"
+       "f_bonds[4]\nvariable en equal f_bonds[5]\n"
+    << "fix pr all print 1 \"${t} ${f2} ${nb} ${nt} ${ns} ${en}\" file force.txt screen no title "
+       "none\n"
     << "thermo 500\nrun " << steps << "\n";
   const auto r = run_deck(dir, d.str());
   EXPECT_EQ(r.exit_code, 0) << r.screen;
@@ -685,6 +686,14 @@ TEST(FlatJointPair, SlowPullBreaksAtTensileStrength) {
   const auto rows = run_prescribed_pair(
       dir, 0.2, 0.0, 2000, 1e-8, flat_joint_fix("break_log breaks.txt dump_bonds bonds.txt"));
   expect_peak_force(rows, kSigmaT * kArea, "flat joint pull");
+  // Output 5, the elastic energy in the elements, at the peak: a pure stretch
+  // stores F^2 / (2 kn A) (1e-6: the same step's force and energy).
+  size_t peak = 0;
+  for (size_t k = 0; k < rows.size(); ++k)
+    if (rows[k][1] > rows[peak][1]) peak = k;
+  const double f = rows[peak][1];
+  EXPECT_NEAR(rows[peak][5] / (f * f / (2.0 * kKnA)), 1.0, 1e-6) << "f_bonds[5] at the peak";
+  EXPECT_EQ(rows.back()[5], 0.0) << "energy left in an open interface";
   EXPECT_EQ(rows.back()[2], 0.0) << "interface still bonded at the end";
   EXPECT_EQ(rows.back()[3], 8.0) << "not all 8 elements broke in tension";
   EXPECT_EQ(rows.back()[4], 0.0);
