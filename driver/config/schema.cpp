@@ -405,6 +405,11 @@ std::vector<KeyDef> calibrate_keys() {
       at_least(key("calibrate.seed", T::Int, "", "2002", "Seed of the specimen packing"), 1),
       key("calibrate.rate_check", T::Bool, "", "true",
           "After the fit, repeat the UCS test at half the strain rate (quasi-static check)"),
+      key("calibrate.sensitivity", T::Bool, "", "true",
+          "After the fit, step each fitted bond parameter alone from the result (x1.2; friction angle +5 deg; "
+          "moment factor -0.25) in one UCS + Brazilian pair each and report each lever's sensitivity (the "
+          "change in each target per change in the lever) and which levers move no target (docs/calibration.md, "
+          "\"Lever sensitivities\")"),
       range(key("calibrate.confining_pressures", T::RealList, "x ucs", "[0.1, 0.2]",
                 "After the fit, one triaxial test per entry at this confining pressure (a fraction of the UCS "
                 "the result reached: the card's ucs when met) with the result's bond parameters: the failure "

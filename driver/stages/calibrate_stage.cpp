@@ -18,6 +18,7 @@
 #include "stages/calibrate/fitting.h"
 #include "stages/calibrate/lab_runs.h"
 #include "stages/calibrate/outputs.h"
+#include "stages/calibrate/sensitivity.h"
 #include "stages/calibrate/specimen.h"
 #include "stages/stage_util.h"
 
@@ -28,8 +29,11 @@ namespace {
 using namespace calibrate;
 
 // Bumped when a deck or the fitting scheme changes what a calibration gives
-// (git log of this line: what each version changed).
-constexpr int kDeckVersion = 4;
+// (git log of this line: what each version changed). 5: the job runs a UCS +
+// Brazilian pair per lever after the rate check (calibrate.sensitivity) and
+// its reports carry the levers' sensitivities: a calibration made before has
+// neither.
+constexpr int kDeckVersion = 5;
 
 // True when the ore card carries a complete calibrated.* section made with
 // the case's bond model and layout (lump.bond_model, lump.joint_*): another
@@ -85,8 +89,9 @@ class Calibration {
   int max_it_ = 1;
 };
 
-// The calibration: pack, iterate the two tests, check the rate, run the
-// checks (triaxial, semi-circular bend), write.
+// The calibration: pack, iterate the two tests, check the rate, step each
+// lever alone (sensitivities), run the checks (triaxial, semi-circular
+// bend), write.
 void Calibration::run() {
   const auto t0 = std::chrono::steady_clock::now();
   fs::create_directories(dir_ / "runs");
@@ -115,11 +120,15 @@ void Calibration::run() {
         "starting the fit from it");
   }
   // Steps of the job: 2 tests per iteration, the half-rate UCS (twice as
-  // long), then the checks.
+  // long), 2 tests per lever of the sensitivities (the model's levers: the
+  // fit keeps the model), then the checks.
   const CheckTargets check_for = check_targets(ore_);
   const double n_checks = static_cast<double>(d_.reals("calibrate.confining_pressures").size()) +
                           (check_for.fracture_toughness ? 1.0 : 0.0);
-  const double steps_total = 2.0 * max_it_ + 2.0 + n_checks;
+  const bool sensitivity = d_.boolean("calibrate.sensitivity");
+  const double n_sensitivity =
+      sensitivity ? 2.0 * static_cast<double>(sensitivity_levers(p).size()) : 0.0;
+  const double steps_total = 2.0 * max_it_ + 2.0 + n_sensitivity + n_checks;
   for (int k = 1; k <= max_it_; ++k) {
     Iteration it;
     it.p = p;
@@ -154,9 +163,25 @@ void Calibration::run() {
     o.half = lab.ucs(
         hist[o.best].p, 0.5 * rate_,
         {"rate_check_ucs", "rate check: UCS at half the strain rate", 2.0 * max_it_ / steps_total});
+  // Sensitivities: each lever stepped alone from the best parameters.
+  if (sensitivity) {
+    o.sensitivity =
+        run_sensitivity(lab, hist[o.best].p, rate_, (2.0 * max_it_ + 2.0) / steps_total,
+                        1.0 / steps_total);
+    const Noise noise = sensitivity_noise(hist[o.best].ucs, o.half ? &*o.half : nullptr);
+    for (const LeverRun& run : o.sensitivity) {
+      const LeverSensitivity s = lever_sensitivity(hist[o.best], run);
+      ctx_.progress.info(fmt::format(
+          "[calibrate] sensitivity of {}: E {:+.1f}%, nu {:+.3f}, UCS {:+.1f}%, tensile "
+          "{:+.1f}% for {}{}",
+          run.lever.row->calibrated, 100 * s.E.change, s.nu.change, 100 * s.ucs.change,
+          100 * s.tensile.change, step_text(run.lever),
+          lever_verdict(s, fit_.tolerance(), noise).free() ? "" : " (moves no target: not free)"));
+    }
+  }
   o.checks = run_checks(lab, hist[o.best].p, hist[o.best].ucs, rate_,
                         confining_pressures(d_, hist[o.best].ucs.r.ucs), check_for,
-                        (2.0 * max_it_ + 2.0) / steps_total, 1.0 / steps_total);
+                        (2.0 * max_it_ + 2.0 + n_sensitivity) / steps_total, 1.0 / steps_total);
   o.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_outputs(ctx_, dir_, fit_, o);
 }
@@ -187,9 +212,12 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
       {"calibration", in,
        from_card
            ? fmt::format("copy calibrated.* from the ore card of {}", ctx.cfg.ore.str("name"))
-           : fmt::format("UCS + Brazilian tests on {} elements, fit to {}; then {} triaxial{} "
+           : fmt::format("UCS + Brazilian tests on {} elements, fit to {}; then {}{} triaxial{} "
                          "check(s)",
                          ctx.cfg.doc.integer("calibrate.n_elements"), ctx.cfg.ore.str("name"),
+                         ctx.cfg.doc.boolean("calibrate.sensitivity")
+                             ? "the levers' sensitivities, "
+                             : "",
                          ctx.cfg.doc.reals("calibrate.confining_pressures").size(),
                          ctx.cfg.ore.has("fracture_toughness") ? " + semi-circular bend" : "")});
   return p;

@@ -31,8 +31,8 @@ const std::string kData = MILL_TEST_DATA;
 
 nlohmann::json read_json(const fs::path& f) { return nlohmann::json::parse(slurp(f)); }
 
-// One tiny calibration (one iteration: both tests once, plus the half-rate
-// UCS) shared by the tests below.
+// One tiny calibration (one iteration: both tests once, the half-rate UCS,
+// the levers' sensitivities and the checks) shared by the tests below.
 class TinyCalibration : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -85,6 +85,9 @@ TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
       {"it1_ucs", r["iterations"][0]["energy"]["ucs"]},
       {"it1_brazilian", r["iterations"][0]["energy"]["brazilian"]},
       {"rate_check_ucs", r["rate_check"]["energy"]},
+      {"sens_bond_modulus_ucs", r["sensitivity"]["levers"]["bond_modulus"]["energy"]["ucs"]},
+      {"sens_bond_moment_factor_brazilian",
+       r["sensitivity"]["levers"]["bond_moment_factor"]["energy"]["brazilian"]},
       {"triaxial_1", r["checks"]["triaxial"][0]["energy"]},
       {"triaxial_2", r["checks"]["triaxial"][1]["energy"]},
       {"scb", r["checks"]["scb"]["energy"]}};
@@ -100,7 +103,8 @@ TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
     EXPECT_GE(e["bond_released_J"].get<double>(), 0.0) << run << ": " << e.dump();
   }
   const auto& worst = r["energy"];
-  EXPECT_EQ(worst["lab_runs"].get<int>(), 6) << worst.dump();
+  // 2 (iteration) + 1 (rate check) + 12 (6 levers) + 3 (checks).
+  EXPECT_EQ(worst["lab_runs"].get<int>(), 18) << worst.dump();
   EXPECT_LT(worst["worst_residual_fraction_max"].get<double>(), 0.01) << worst.dump();
   const std::string worst_run = worst["worst_run"].get<std::string>();
   EXPECT_TRUE(std::any_of(runs.begin(), runs.end(), [&](const auto& run) {
@@ -109,6 +113,7 @@ TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
   const std::string md = slurp(*dir_ / "calibrate" / "report.md");
   EXPECT_NE(md.find("## Energy ledger"), std::string::npos) << md;
   for (const char* row : {"| it1_ucs * |", "| it1_brazilian * |", "| rate_check_ucs |",
+                          "| sens_bond_modulus_ucs |", "| sens_bond_cohesion_brazilian |",
                           "| triaxial_1 |", "| triaxial_2 |", "| scb |"})
     EXPECT_NE(md.find(row), std::string::npos) << row << " in\n" << md;
   EXPECT_NE(md.find("Largest residual of any lab run: "), std::string::npos) << md;
@@ -160,6 +165,34 @@ TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
   EXPECT_NE(md.find("## Checks after the fit (not a lever yet)"), std::string::npos) << md;
   EXPECT_NE(md.find("| friction angle (deg) | 47.0 |"), std::string::npos) << md;
 
+  // The levers' sensitivities (issue 28): the parallel bond's six fitted
+  // levers, each stepped alone from the result, a finite sensitivity of each
+  // target, and the signs physics fixes: a stiffer bond makes a stiffer
+  // specimen (E about proportional to E_b), a stronger bond a stronger disc.
+  const auto& sens = r["sensitivity"];
+  ASSERT_TRUE(sens.is_object()) << r.dump(2);
+  const auto& lv = sens["levers"];
+  ASSERT_EQ(lv.size(), 6u) << sens.dump(2);
+  for (const char* name : {"bond_modulus", "stiffness_ratio", "bond_tensile_strength",
+                           "bond_cohesion", "bond_friction_angle", "bond_moment_factor"}) {
+    ASSERT_TRUE(lv.contains(name)) << name << " in " << sens.dump(2);
+    const auto& l = lv[name];
+    EXPECT_NE(l["step"]["to"].get<double>(), l["step"]["from"].get<double>()) << l.dump();
+    for (const char* k : {"youngs_modulus", "poisson_ratio", "ucs", "tensile_strength"})
+      EXPECT_TRUE(std::isfinite(l["targets"][k]["value"].get<double>())) << name << " " << k;
+    EXPECT_TRUE(l["free"].is_boolean()) << l.dump();
+  }
+  EXPECT_DOUBLE_EQ(lv["bond_modulus"]["step"]["size"].get<double>(), 1.2);
+  EXPECT_DOUBLE_EQ(lv["bond_friction_angle"]["step"]["size"].get<double>(), 5.0);
+  EXPECT_GT(lv["bond_modulus"]["targets"]["youngs_modulus"]["value"].get<double>(), 0.5)
+      << sens.dump(2);
+  EXPECT_GT(lv["bond_tensile_strength"]["targets"]["tensile_strength"]["value"].get<double>(), 0.0)
+      << sens.dump(2);
+  EXPECT_TRUE(lv["bond_modulus"]["free"].get<bool>()) << sens.dump(2);
+  EXPECT_NE(md.find("## Lever sensitivities"), std::string::npos) << md;
+  EXPECT_NE(md.find("| bond_modulus | x1.2 ("), std::string::npos) << md;
+  EXPECT_NE(md.find("per step: "), std::string::npos) << md;
+
   // A rerun skips the done job.
   const int st = orchestrate(
       "--case " + kData + "/tiny_calibrate.yaml --stage calibrate --output " + dir_->string(),
@@ -189,7 +222,7 @@ std::string tiny_case(const fs::path& card_file, int iterations) {
       "name: synthetic\nore: {{card: {}}}\nlump: {{n_elements: 150, diameter: 0.02, bond_gap: "
       "0.2}}\n"
       "calibrate: {{n_elements: 200, max_iterations: {}, strain_rate: 2.0, seed: 2003, "
-      "rate_check: false}}\nresources: {{np: 1, jobs: 1}}\n",
+      "rate_check: false, sensitivity: false}}\nresources: {{np: 1, jobs: 1}}\n",
       card_file.string(), iterations);
 }
 

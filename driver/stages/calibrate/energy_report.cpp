@@ -35,7 +35,8 @@ nlohmann::json lab_energy_json(const post::LedgerSummary& e) {
           {"end_time_s", e.end_time_s}};
 }
 
-// Iterations in order, each UCS then Brazilian, the rate check last.
+// Iterations in order, each UCS then Brazilian, the rate check, the levers'
+// sensitivity pairs, then the checks.
 std::vector<const LabRun*> lab_runs(const Outcome& o) {
   std::vector<const LabRun*> runs;
   for (const Iteration& it : o.hist) {
@@ -43,6 +44,10 @@ std::vector<const LabRun*> lab_runs(const Outcome& o) {
     runs.push_back(&it.br);
   }
   if (o.half) runs.push_back(&*o.half);
+  for (const LeverRun& l : o.sensitivity) {
+    runs.push_back(&l.ucs);
+    runs.push_back(&l.br);
+  }
   for (const TriaxialRun& t : o.checks.triaxial) runs.push_back(&t);
   if (o.checks.scb) runs.push_back(&*o.checks.scb);
   return runs;
@@ -61,7 +66,8 @@ nlohmann::json energy_summary_json(const Outcome& o) {
        {{"ledgers",
          "jobs/calibration/runs/<run>/ledger.csv (fix energy/ledger, "
          "docs/styles/fix_energy_ledger.md); each run's figures are in its `energy` object "
-         "(iterations[].energy.ucs, .brazilian, rate_check.energy)"},
+         "(iterations[].energy.ucs, .brazilian, rate_check.energy, "
+         "sensitivity.levers.<lever>.energy, checks.triaxial[].energy, checks.scb.energy)"},
         {"work_other_J",
          "the platens' drive: work done on the specimen by the moving platens (triaxial: and by "
          "the confining forces)"},

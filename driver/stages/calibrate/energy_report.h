@@ -18,8 +18,8 @@ namespace mill::calibrate {
 nlohmann::json lab_energy_json(const post::LedgerSummary& e);
 
 // Every lab run of a fit in the order they ran: each iteration's UCS and
-// Brazilian tests, the rate check's UCS, then the checks' triaxial and
-// semi-circular bend tests.
+// Brazilian tests, the rate check's UCS, each lever's sensitivity UCS and
+// Brazilian tests, then the checks' triaxial and semi-circular bend tests.
 std::vector<const LabRun*> lab_runs(const Outcome& o);
 
 // report.json's top-level `energy` object: the worst |residual_fraction_max|

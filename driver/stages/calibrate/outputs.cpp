@@ -66,6 +66,7 @@ class Report {
         hash_(ore_hash(cfg.ore)),
         rate_change_(o.half ? post::RelativeError(o.half->r.ucs, b_.ucs.r.ucs) : 0.0),
         rate_ok_(rate_change_ < 0.05),
+        noise_(sensitivity_noise(b_.ucs, o.half ? &*o.half : nullptr)),
         ui_(b_.ucs.info),
         bi_(b_.br.info),
         missed_(explain_missed()) {}
@@ -97,6 +98,7 @@ class Report {
   const std::string hash_;
   const double rate_change_;
   const bool rate_ok_;
+  const Noise noise_;  // run-to-run noise of the sensitivities
   const std::map<std::string, double>& ui_;  // info line of the result's UCS run
   const std::map<std::string, double>& bi_;  // and of its Brazilian run
   const std::vector<std::string> missed_;
@@ -245,6 +247,9 @@ nlohmann::json Report::json() const {
                                             {"energy", lab_energy_json(half_->energy)},
                                             {"wall_seconds", half_->seconds}}
                            : nlohmann::json(nullptr)},
+      {"sensitivity", o_.sensitivity.empty()
+                          ? nlohmann::json(nullptr)
+                          : sensitivity_json(b_, o_.sensitivity, tol_, noise_)},
       {"checks", checks_json(o_.checks, b_.ucs.r.ucs)},
       {"energy", energy_summary_json(o_)},
       {"not_reached", missed_},
@@ -338,6 +343,10 @@ std::string Report::markdown() const {
         rate_ok_ ? "below 5%: quasi-static" : "5% or more: lower calibrate.strain_rate");
   else
     md << "\n## Loading rate\n\nNot checked (calibrate.rate_check: false).\n";
+  if (!o_.sensitivity.empty())
+    md << sensitivity_markdown(b_, o_.sensitivity, tol_, noise_);
+  else
+    md << "\n## Lever sensitivities\n\nNot measured (calibrate.sensitivity: false).\n";
   md << checks_markdown(o_.checks, b_.ucs.r.ucs);
   md << energy_markdown(o_);
   md << fmt::format(

@@ -12,6 +12,7 @@
 #include "stages/calibrate/checks.h"
 #include "stages/calibrate/fitting.h"
 #include "stages/calibrate/lab_runs.h"
+#include "stages/calibrate/sensitivity.h"
 #include "stages/calibrate/specimen.h"
 #include "stages/stage.h"
 
@@ -23,6 +24,7 @@ struct Outcome {
   std::vector<Iteration> hist;  // every iteration, in order
   size_t best = 0;              // index in hist of the result
   std::optional<UcsRun> half;   // rate check: the result's UCS test at half the strain rate
+  std::vector<LeverRun> sensitivity;  // one perturbed UCS + Brazilian pair per lever (or none)
   Checks checks;                // triaxial envelope and toughness with the result's parameters
   std::vector<std::string> notes;
   double wall = 0;  // s, the whole job
