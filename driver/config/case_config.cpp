@@ -545,8 +545,9 @@ void check_physics(const Document& d) {
           d.where("lump.joint_sectors"), rings, sectors, rings * sectors, kMaxJointElements));
     if (d.boolean("lump.broken_contact"))
       throw ConfigError(fmt::format(
-          "{}: lump.broken_contact is the parallel bond's; a flat joint's broken elements always stay as "
-          "frictional contacts: remove it, or set lump.bond_model: parallel",
+          "{}: an option of the parallel bond, not of lump.bond_model: flat_joint (a flat joint's broken "
+          "elements always stay as frictional contacts); expected false or absent: remove it, or set "
+          "lump.bond_model: parallel",
           d.where("lump.broken_contact")));
   }
   check_unique_items(d, "rotor.rpm", "rpm");
