@@ -137,33 +137,31 @@ std::vector<std::string> Report::explain_missed() const {
     double best_ratio = 0.0;
     for (const auto& it : hist_)
       best_ratio = std::max(best_ratio, it.ucs.r.ucs / it.br.r.tensile_strength);
-    const bool fj = b_.p.model == BondModel::flat_joint;
+    // Where the UCS/tensile levers stand, by model; the same head and tail.
+    const double c_ratio = b_.p.cohesion / b_.p.tensile;
+    const char* cap = c_ratio >= kMaxCohesionRatio * 0.999 ? ", at its cap" : "";
+    const std::string levers =
+        b_.p.model == BondModel::flat_joint
+            ? fmt::format(
+                  "With flat joints ({}) the fit moves one lever for the ratio, the cohesion ratio "
+                  "(now {:.2f}{}); it rises with the coordination (interfaces per element, set by "
+                  "lump.bond_gap), so a wider bond gap or more iterations "
+                  "(calibrate.max_iterations) may reach it (bench/README.md, \"Strength ratio: "
+                  "coordination and cohesion with the flat joint\")",
+                  bond_model_text(b_.p), c_ratio, cap)
+            : fmt::format(
+                  "Bonded sphere packings fail by bond tension under compression too; the levers "
+                  "the fit moves, moment factor (now {:g}), bond friction angle (now {:g} deg) and "
+                  "cohesion ratio (now {:.2f}{}), raise the ratio by tens of percent, not by the "
+                  "factor needed (bench/README.md, \"Rock strength levers\")",
+                  b_.p.moment_factor, b_.p.friction_angle_deg, c_ratio, cap);
     missed.push_back(
-        post::RelativeError(ratio, want) > tol_ && fj
-            ? fmt::format(
-                  "UCS {:.1f} MPa is {:.0f}% off the target: UCS/tensile reached {:.1f} against "
-                  "{:.1f} on the card (at most {:.1f} over the {} iterations). With flat joints ({}) "
-                  "the fit moves one lever for the ratio, the cohesion ratio (now {:.2f}{}); it rises "
-                  "with the coordination (interfaces per element, set by lump.bond_gap), so a "
-                  "wider bond gap or more iterations (calibrate.max_iterations) may reach it "
-                  "(bench/README.md, \"Strength ratio: coordination and cohesion with the flat "
-                  "joint\"){}",
-                  b_.ucs.r.ucs / 1e6, 100 * b_.err_ucs, ratio, want, best_ratio, hist_.size(),
-                  bond_model_text(b_.p), b_.p.cohesion / b_.p.tensile,
-                  b_.p.cohesion / b_.p.tensile >= kMaxCohesionRatio * 0.999 ? ", at its cap" : "",
-                  lever)
-        : post::RelativeError(ratio, want) > tol_
-            ? fmt::format(
-                  "UCS {:.1f} MPa is {:.0f}% off the target: UCS/tensile reached {:.1f} against "
-                  "{:.1f} on the card (at most {:.1f} over the {} iterations). Bonded sphere "
-                  "packings fail by bond tension under compression too; the levers the fit moves, "
-                  "moment factor (now {:g}), bond friction angle (now {:g} deg) and cohesion ratio "
-                  "(now {:.2f}{}), raise the ratio by tens of percent, not by the factor needed "
-                  "(bench/README.md, \"Rock strength levers\"){}",
-                  b_.ucs.r.ucs / 1e6, 100 * b_.err_ucs, ratio, want, best_ratio, hist_.size(),
-                  b_.p.moment_factor, b_.p.friction_angle_deg, b_.p.cohesion / b_.p.tensile,
-                  b_.p.cohesion / b_.p.tensile >= kMaxCohesionRatio * 0.999 ? ", at its cap" : "",
-                  lever)
+        post::RelativeError(ratio, want) > tol_
+            ? fmt::format("UCS {:.1f} MPa is {:.0f}% off the target: UCS/tensile reached {:.1f} "
+                          "against {:.1f} on the card (at most {:.1f} over the {} iterations). "
+                          "{}{}",
+                          b_.ucs.r.ucs / 1e6, 100 * b_.err_ucs, ratio, want, best_ratio,
+                          hist_.size(), levers, lever)
             : fmt::format("UCS {:.1f} MPa is {:.0f}% off the target (UCS/tensile "
                           "{:.1f} is right: the strength level needs more iterations)",
                           b_.ucs.r.ucs / 1e6, 100 * b_.err_ucs, ratio));
