@@ -32,8 +32,9 @@ using namespace calibrate;
 // (git log of this line: what each version changed). 5: the job runs a UCS +
 // Brazilian pair per lever after the rate check (calibrate.sensitivity) and
 // its reports carry the levers' sensitivities: a calibration made before has
-// neither.
-constexpr int kDeckVersion = 5;
+// neither. 6: the fit steps all four continuous parameters together on a
+// local linear model (calibrate/local_model.h) instead of one secant each.
+constexpr int kDeckVersion = 6;
 
 // True when the ore card carries a complete calibrated.* section made with
 // the case's bond model and layout (lump.bond_model, lump.joint_*): another

@@ -1,6 +1,6 @@
 // The fitting scheme of the calibrate stage (docs/calibration.md, "Fitting
 // scheme"): the errors of an iteration against the ore card, the next bond
-// parameters (one damped secant step per parameter), and the iteration kept
+// parameters (a damped Gauss-Newton step on a local linear model), and the iteration kept
 // as the result. A change here changes what a calibration gives: bump
 // kDeckVersion in calibrate_stage.cpp.
 #pragma once
@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "lump/material.h"
+#include "stages/calibrate/local_model.h"
 #include "stages/calibrate/lab_runs.h"
 
 namespace mill::calibrate {
@@ -22,6 +23,18 @@ inline constexpr double kMaxCohesionRatio = 50.0;
 // 1.73; above it tau_c = c - sigma_n tan(phi) leaves little shear strength
 // under tension.
 inline constexpr double kMaxFrictionAngle = 60.0;
+// Bounds of kn/ks and of c / sigma_b from below.
+inline constexpr double kMinStiffnessRatio = 0.5;
+inline constexpr double kMaxStiffnessRatio = 20.0;
+inline constexpr double kMinCohesionRatio = 0.1;
+// The local model: iterations it uses at most, the ridge weight of the prior
+// slopes (as a difference of 0.14 in log parameters), the step's damping
+// (relative to the prior's diagonal), and the UCS's weight when the ratio is
+// out of reach (the tensile strength first).
+inline constexpr size_t kModelPoints = 5;
+inline constexpr double kRidge = 0.02;
+inline constexpr double kDamping = 0.01;
+inline constexpr double kUcsWeightOutOfReach = 0.05;
 // The coarse UCS/tensile levers (moment factor, friction angle) move only
 // while the card's ratio is more than this factor above the one reached.
 inline constexpr double kCoarseLeverGap = 1.2;
@@ -36,6 +49,14 @@ struct Iteration {
   double score = 0;  // worst error in units of its tolerance
 };
 
+// The flat joint's local model's start: prior slopes J0, the range each
+// measured slope is kept in, the step cap per parameter (local_model.h).
+struct LocalModelPrior {
+  Mat4 J0{}, lo{}, hi{};
+  Vec4 max_step{};
+};
+LocalModelPrior flat_joint_prior();
+
 // Fits to the targets within relative tolerance tol (nu: kNuTolerance).
 class Fitting {
  public:
@@ -45,8 +66,17 @@ class Fitting {
 
   // Errors of one iteration against the ore card and whether all are met.
   void score(Iteration& it) const;
-  // Next micro parameters from the iterations so far.
+  // Next micro parameters from the iterations so far (by the last one's
+  // bond model: secant_update or joint_update).
   BondParams update(const std::vector<Iteration>& hist, std::vector<std::string>& notes) const;
+  // The parallel bond's: one damped secant step per parameter on its own
+  // target, then its coarse UCS/tensile levers.
+  BondParams secant_update(const std::vector<Iteration>& hist,
+                           std::vector<std::string>& notes) const;
+  // The flat joint's: one damped Gauss-Newton step of all four on the local
+  // linear model (local_model.h).
+  BondParams joint_update(const std::vector<Iteration>& hist,
+                          std::vector<std::string>& notes) const;
   // Index of the iteration kept as the result.
   size_t best(const std::vector<Iteration>& hist) const;
 

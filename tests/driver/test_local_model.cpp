@@ -1,0 +1,147 @@
+// The fit's local linear model (stages/calibrate/local_model.h) against
+// closed forms: the small solver, the multi-secant Jacobian on exactly
+// linear data, the damped step and its bounds.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "stages/calibrate/local_model.h"
+
+using namespace mill::calibrate;
+
+namespace {
+
+Mat4 identity() {
+  Mat4 m{};
+  for (size_t i = 0; i < 4; ++i) m[i][i] = 1.0;
+  return m;
+}
+
+Mat4 filled(double v) {
+  Mat4 m{};
+  for (auto& r : m) r.fill(v);
+  return m;
+}
+
+StepRule plain_rule() {
+  StepRule r;
+  r.weight = {1, 1, 1, 1};
+  r.mu = 0.0;
+  r.scale = {1, 1, 1, 1};
+  r.max_step = {10, 10, 10, 10};
+  r.lower = {-1e300, -1e300, -1e300, -1e300};
+  r.upper = {1e300, 1e300, 1e300, 1e300};
+  return r;
+}
+
+}  // namespace
+
+// A 3 x 3 system with a zero first pivot (needs the row swap); exact to 1e-12.
+TEST(LocalModel, SolveSmallPivots) {
+  std::vector<std::vector<double>> A{{0, 2, 1}, {1, 1, 0}, {2, 0, 3}};
+  const std::vector<double> x_true{1.5, -2.0, 0.25};
+  std::vector<double> b(3, 0.0), x;
+  for (size_t r = 0; r < 3; ++r)
+    for (size_t c = 0; c < 3; ++c) b[r] += A[r][c] * x_true[c];
+  ASSERT_TRUE(solve_small(A, b, x));
+  for (size_t i = 0; i < 3; ++i) EXPECT_NEAR(x[i], x_true[i], 1e-12);
+  EXPECT_FALSE(solve_small({{1, 2}, {2, 4}}, {1, 2}, x));
+}
+
+// One point: no difference to learn from, the prior comes back unchanged.
+TEST(LocalModel, OnePointGivesThePrior) {
+  const Mat4 prior = identity();
+  const Mat4 J = estimate_jacobian({ModelPoint{}}, prior, 0.02, filled(-5), filled(5));
+  for (size_t i = 0; i < 4; ++i)
+    for (size_t m = 0; m < 4; ++m) EXPECT_EQ(J[i][m], prior[i][m]);
+}
+
+// Five points of an exactly linear map whose four differences span the
+// parameters: with a vanishing ridge the map comes back to 1e-6.
+TEST(LocalModel, RecoversALinearMap) {
+  const Mat4 Jt{{{1.1, -0.3, 0.0, 0.05}, {0.02, 0.12, 0.0, 0.03}, {0.1, 0.2, 0.9, 0.6},
+                 {0.0, -0.1, 1.0, 0.45}}};
+  const Vec4 y0{3.0, 0.2, 1.0, -1.0};
+  const std::vector<Vec4> us{{0.1, 0.2, 0.3, 0.4}, {0.5, 0.1, -0.2, 0.3}, {0.0, 0.6, 0.1, -0.1},
+                             {-0.3, 0.2, 0.7, 0.2}, {0.2, -0.4, 0.1, 0.9}};
+  std::vector<ModelPoint> pts;
+  for (const Vec4& u : us) pts.push_back({u, [&] {
+                                            Vec4 y = predict(Jt, u);
+                                            for (size_t i = 0; i < 4; ++i) y[i] += y0[i];
+                                            return y;
+                                          }()});
+  const Mat4 J = estimate_jacobian(pts, identity(), 1e-12, filled(-5), filled(5));
+  for (size_t i = 0; i < 4; ++i)
+    for (size_t m = 0; m < 4; ++m) EXPECT_NEAR(J[i][m], Jt[i][m], 1e-6) << i << "," << m;
+}
+
+// One difference along the first parameter: that column follows the data
+// (slope 2 from the ridge solution 2 d^2 / (d^2 + lambda) with d = 0.5,
+// lambda = 0.02 pulling towards the prior's 1: (2 * 0.25 + 0.02) / 0.27),
+// the other columns keep the prior; a clamp caps what the data says.
+TEST(LocalModel, OneDifferenceMovesOneColumn) {
+  const Mat4 prior = identity();
+  std::vector<ModelPoint> pts(2);
+  pts[0].u = {0.5, 0, 0, 0};
+  pts[0].y = {1.0, 0, 0, 0};
+  const Mat4 J = estimate_jacobian(pts, prior, 0.02, filled(-5), filled(5));
+  EXPECT_NEAR(J[0][0], (2.0 * 0.25 + 0.02) / 0.27, 1e-12);
+  EXPECT_NEAR(J[1][1], 1.0, 1e-12);
+  EXPECT_NEAR(J[0][1], 0.0, 1e-12);
+  Mat4 hi = filled(5);
+  hi[0][0] = 1.5;
+  EXPECT_EQ(estimate_jacobian(pts, prior, 0.02, filled(-5), hi)[0][0], 1.5);
+}
+
+// Undamped and within bounds, the step solves J du = e exactly (1e-12).
+TEST(LocalModel, UndampedStepIsNewtons) {
+  const Mat4 J{{{1.0, 0.2, 0, 0}, {0, 0.1, 0, 0}, {0, 0, 1.0, 0.8}, {0, 0, 1.0, 0.35}}};
+  const Vec4 e{0.3, -0.02, 0.4, 0.1};
+  const Vec4 du = damped_step(J, e, Vec4{}, plain_rule());
+  const Vec4 dy = predict(J, du);
+  for (size_t i = 0; i < 4; ++i) EXPECT_NEAR(dy[i], e[i], 1e-12);
+}
+
+// Damping on a diagonal J: du_m = w^2 J e / (w^2 J^2 + mu s^2) (Marquardt
+// 1963 for one parameter), 1e-12.
+TEST(LocalModel, DampedStepOnADiagonal) {
+  Mat4 J = identity();
+  J[1][1] = 0.1;
+  StepRule r = plain_rule();
+  r.weight = {10, 20, 10, 10};
+  r.scale = {10, 2, 10, 10};
+  r.mu = 0.1;
+  const Vec4 e{0.3, 0.05, -0.2, 0.1};
+  const Vec4 du = damped_step(J, e, Vec4{}, r);
+  for (size_t m = 0; m < 4; ++m) {
+    const double w = r.weight[m], j = J[m][m], s = r.scale[m];
+    EXPECT_NEAR(du[m], w * w * j * e[m] / (w * w * j * j + r.mu * s * s), 1e-12) << m;
+  }
+}
+
+// A step past its cap is fixed at the cap and the others re-solved: two
+// strengths that both follow u2 (slope 1) and the ratio u3 (slopes 0.8 and
+// 0.35); the Newton step wants du3 = (e2 - e3) / 0.45 = 1.54 > cap 1.
+// With du3 = 1, du2 minimises (du2 + 0.8 - e2)^2 + (du2 + 0.35 - e3)^2:
+// du2 = (e2 + e3 - 1.15) / 2.
+TEST(LocalModel, CappedComponentIsFixedAndTheRestResolved) {
+  const Mat4 J{{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1.0, 0.8}, {0, 0, 1.0, 0.35}}};
+  StepRule r = plain_rule();
+  r.max_step = {10, 10, 10, 1.0};
+  const Vec4 e{0, 0, std::log(2.0), 0.0};
+  const Vec4 du = damped_step(J, e, Vec4{}, r);
+  EXPECT_NEAR(du[3], 1.0, 1e-12);
+  EXPECT_NEAR(du[2], (std::log(2.0) + 0.0 - 1.15) / 2.0, 1e-12);
+  // A bound on the value acts the same way: u3 = 0.5 with an upper bound 1.2.
+  r.max_step = {10, 10, 10, 10};
+  r.upper[3] = 1.2;
+  const Vec4 dv = damped_step(J, e, Vec4{0, 0, 0, 0.5}, r);
+  EXPECT_NEAR(dv[3], 0.7, 1e-12);
+  EXPECT_NEAR(dv[2], (std::log(2.0) - 0.7 * 1.15) / 2.0, 1e-12);
+  // A parameter that is not free does not move.
+  r.free[3] = 0.0;
+  const Vec4 dw = damped_step(J, e, Vec4{}, r);
+  EXPECT_EQ(dw[3], 0.0);
+  EXPECT_NEAR(dw[2], std::log(2.0) / 2.0, 1e-12);
+}
