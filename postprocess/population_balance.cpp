@@ -218,17 +218,16 @@ CircuitState SolveCircuit(const SizeClasses& classes, const BreakageMatrix& b,
     double from_coarser = 0.0;
     for (std::size_t j = 0; j < i; ++j) from_coarser += b[i][j] * m[j];
     const double inflow = feed[i] + c[i] * from_coarser;
-    const double leaves =
-        1.0 - c[i] * b[i][i];  // share of the class's input that leaves it per pass
+    // The share of the class's input that leaves it per pass.
+    const double leaves = 1.0 - c[i] * b[i][i];
     if (leaves < kNeverLeaves) {
       if (inflow > 0.0)
-        throw PostError(
-            fmt::format("the {} class lies above the cut (returned {:.6g}) and does not break "
-                        "(b[{}][{}] = {:.12g}): its "
-                        "mass never leaves the mill and the circuit has no steady state; expected "
-                        "a breakage function that "
-                        "moves part of this class finer, or a cut above it",
-                        classes.name(i), c[i], i, i, b[i][i]));
+        throw PostError(fmt::format(
+            "the {} class lies above the cut (returned {:.6g}) and does not break "
+            "(b[{}][{}] = {:.12g}): its mass never leaves the mill and the circuit has no "
+            "steady state; expected a breakage function that moves part of this class "
+            "finer, or a cut above it",
+            classes.name(i), c[i], i, i, b[i][i]));
       continue;  // nothing reaches it: m_i = 0
     }
     m[i] = inflow / leaves;
@@ -279,9 +278,8 @@ PassHistory IterateCircuit(const SizeClasses& classes, const BreakageMatrix& b,
     }
   throw PostError(
       fmt::format("pass iteration: after {} passes {:.3g} of a feed batch is still in the circuit "
-                  "(expected at most {:g}); "
-                  "the {} class returns {:.6g} of its mass unbroken each pass, so about {:.3g} "
-                  "passes are needed",
+                  "(expected at most {:g}); the {} class returns {:.6g} of its mass unbroken each "
+                  "pass, so about {:.3g} passes are needed",
                   max_passes, h.remaining.back(), tolerance, classes.name(slow), rho,
                   std::log(tolerance) / std::log(rho)));
 }
