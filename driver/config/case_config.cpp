@@ -818,6 +818,7 @@ CaseConfig load_case(const fs::path& file, const fs::path& project_dir,
   c.doc = Document::parse(text, file.string(), case_schema(), overrides);
   check_case(c.doc);
   check_name(c.doc);
+  c.feed = read_feed(c.doc);
   c.name = c.doc.str("name");
   c.ore_file = resolve_ore(c.doc, file, project_dir);
   c.ore = Document::load(c.ore_file, ore_schema());

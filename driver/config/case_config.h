@@ -8,10 +8,12 @@
 
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "config/feed.h"
 #include "config/schema.h"
 
 namespace mill::config {
@@ -62,6 +64,7 @@ struct CaseConfig {
   Document doc;                       // validated case
   std::filesystem::path ore_file;     // resolved ore card (absolute)
   Document ore;                       // validated ore card
+  std::optional<Feed> feed;           // the feed section (config/feed.h); none: one lump size
   std::filesystem::path project_dir;  // templates, foam_case, ... live here
 };
 

@@ -126,6 +126,13 @@ const char* kPlantTemperatureSource =
     "plant conditions: cold ambient air (-70 degC) to the hot gas of a drying mill (about 600 degC)";
 const char* kFeedSource = "the feed of impact crushers and hammer mills, a few mm to a few dm (Wills & Finch 2016, the chapter on crushers)";
 
+const char* kSieveSource =
+    "sieve sizes of a crusher's feed and product, from fines of a few um to feed lumps of a few dm (Wills & "
+    "Finch 2016, the chapters on particle size analysis and on crushers), with a margin";
+const char* kThroughputSource =
+    "a mill's throughput, from laboratory rotor mills (a few kg/h) to the largest hammer mills and impact "
+    "crushers (a few thousand t/h; Wills & Finch 2016, the chapter on crushers), with a margin";
+
 const char* kRockDensitySource =
     "Schoen 2011, Physical Properties of Rocks: coal about 1300 kg/m^3, sandstone 2000-2700, basalt about "
     "3000, ore minerals up to galena's 7500";
@@ -392,6 +399,45 @@ std::vector<KeyDef> breakage_keys() {
                    1000)};
 }
 
+// A size of the feed or the product in mm, with its plausible range.
+KeyDef sieve_mm(KeyDef k) {
+  return plausible(positive(std::move(k)), 1e-3, 1000, "a sieve size of a crusher's feed or product", kSieveSource,
+                   {{"m", 1e3}, {"um", 1e-3}});
+}
+
+// The feed of the mill and its cut: the population balance's inputs
+// (docs/population_balance.md). Optional as a whole: a case without any
+// feed.* key runs one lump size. No key has a default, so a case without a
+// feed keeps its job ids and inputs hash.
+std::vector<KeyDef> feed_keys() {
+  return {
+      opt(sieve_mm(key("feed.sizes_mm", T::RealList, "mm", "",
+                       "Feed: the sieves of the population balance, ascending; each is the upper edge of a size "
+                       "class (pieces that pass it and stay on the sieve below; the finest class runs down to 0). "
+                       "List the product's fine sieves too, with fraction 0: the product P80 is read off them. "
+                       "Required with a feed"))),
+      opt(plausible(range(key("feed.mass_fractions", T::RealList, "", "",
+                              "Feed: mass fraction of each class of feed.sizes_mm (as many), summing to 1 within 1e-6 "
+                              "(then scaled to sum to 1 exactly); or feed.rosin_rammler instead"),
+                          0, false, 1, false),
+                    0, 1, "a mass fraction", "a mass fraction lies in [0, 1]", {{"%", 0.01}})),
+      opt(sieve_mm(key("feed.rosin_rammler.d63_mm", T::Real, "mm", "",
+                       "Feed: Rosin-Rammler size through which 63.2 % of the mass passes, F(d) = 1 - "
+                       "exp(-(d/d63)^n) (Rosin & Rammler 1933), put on the classes of feed.sizes_mm (the top class "
+                       "also takes the tail above the top sieve, at most 1 %); instead of feed.mass_fractions"))),
+      opt(positive(key("feed.rosin_rammler.n", T::Real, "", "",
+                       "Feed: Rosin-Rammler uniformity n; give with feed.rosin_rammler.d63_mm"))),
+      opt(plausible(positive(key("feed.rate_tph", T::Real, "t/h", "", "Feed: fresh feed rate. Required with a feed")),
+                    1e-3, 1e4, "a mill's throughput", kThroughputSource, {{"kg/h", 1e-3}, {"kg/s", 3.6}})),
+      opt(sieve_mm(key("feed.cut_size_mm", T::Real, "mm", "",
+                       "Feed: the mill's cut, the aperture of its outlet grate or classifier: pieces above it go "
+                       "round again, those below leave (a class across it splits in log size); at or above the "
+                       "finest sieve. Required with a feed"))),
+      opt(sieve_mm(key("feed.target_p80_mm", T::Real, "mm", "",
+                       "Feed: the product P80 wanted (optional); at or above the finest sieve and below "
+                       "feed.cut_size_mm")))};
+}
+
 // The calibration's virtual lab tests.
 std::vector<KeyDef> calibrate_keys() {
   return {
@@ -443,7 +489,7 @@ std::vector<KeyDef> resources_keys() {
 Schema make_case_schema() {
   Schema s;
   s.what = "case file";
-  for (const auto& part : {mill_keys(), flow_keys(), transport_keys(), lump_keys(), breakage_keys(),
+  for (const auto& part : {mill_keys(), flow_keys(), transport_keys(), lump_keys(), breakage_keys(), feed_keys(),
                            calibrate_keys(), resources_keys()})
     s.keys.insert(s.keys.end(), part.begin(), part.end());
   return s;
@@ -628,6 +674,10 @@ std::string schema_markdown() {
     << "takes its default; an unknown key is an error.\n\n"
     << "## Case file (`cases/*.yaml`)\n\n";
   table(o, case_schema());
+  o << "\nThe `feed.*` keys are optional as a whole: without any, a case runs one lump size. With a feed,\n"
+    << "`feed.sizes_mm`, `feed.rate_tph`, `feed.cut_size_mm` and exactly one distribution (`feed.mass_fractions`\n"
+    << "or `feed.rosin_rammler`) are required; the rules and an example are in docs/population_balance.md,\n"
+    << "\"The feed in the case\".\n";
   o << "\n## Ore card (`liggghts_inputs/materials/*.yaml`)\n\n";
   table(o, ore_schema());
   o << "\n## Plausible ranges\n\n"
