@@ -449,6 +449,13 @@ std::vector<KeyDef> calibrate_keys() {
       positive(key("calibrate.tolerance", T::Real, "", "0.1",
                    "Relative tolerance on E, UCS and tensile strength")),
       at_least(key("calibrate.seed", T::Int, "", "2002", "Seed of the specimen packing"), 1),
+      range(key("calibrate.starts", T::Int, "", "1",
+                "Fits from different starts: 1 fits from the closed-form estimate; N > 1 adds N - 1 fits "
+                "from that estimate scaled within x/÷ 2 (Halton points), each a parameter set of its own "
+                "(calibrate/sets.json), and the breakage stage repeats its impacts with every set to give the "
+                "band of critical impact speeds the ore card leaves open (docs/calibration.md, \"Parameter "
+                "sets from different starts\"). Each start costs a fit; each set, the sweep's impacts again"),
+            1, false, 8, false),
       key("calibrate.rate_check", T::Bool, "", "true",
           "After the fit, repeat the UCS test at half the strain rate (quasi-static check)"),
       key("calibrate.sensitivity", T::Bool, "", "true",

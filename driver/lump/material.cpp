@@ -77,6 +77,24 @@ BondParams bond_params_for(const config::CaseConfig& cfg, const fs::path& run_di
   return b;
 }
 
+fs::path set_calibration_file(const fs::path& run_dir, int k) {
+  return run_dir / "calibrate" / "sets" / ("start" + std::to_string(k)) / "calibrated.yaml";
+}
+
+BondParams bond_params_for_set(const config::CaseConfig& cfg, const fs::path& run_dir, int k) {
+  if (k <= 1) return bond_params_for(cfg, run_dir);
+  BondParams c = estimate_bond_params(cfg.ore, cfg.doc);
+  const fs::path f = set_calibration_file(run_dir, k);
+  if (!read_calibrated_file(f, ore_hash(cfg.ore), c))
+    throw std::runtime_error(fmt::format(
+        "{}: no calibration of start {} fitted to this ore card with the case's bond model "
+        "({}); run `orchestrate --stage calibrate` with calibrate.starts >= {}",
+        f.string(), k, fs::exists(f) ? "fitted to other properties or another model" : "missing",
+        k));
+  c.origin = fmt::format("calibration set {} ({})", k, f.string());
+  return c;
+}
+
 std::vector<std::pair<std::string, std::string>> material_vars(const config::Document& ore,
                                                                const BondParams& b,
                                                                const config::Document& doc) {

@@ -25,6 +25,17 @@ BondParams estimate_bond_params(const config::Document& ore, const config::Docum
 // properties with the case's bond model and layout), the closed-form estimates.
 BondParams bond_params_for(const config::CaseConfig& cfg, const std::filesystem::path& run_dir);
 
+// Where a run folder keeps the calibration of start k >= 2 of the calibrate
+// stage (calibrate.starts; docs/calibration.md, "Parameter sets from
+// different starts"): <run>/calibrate/sets/start<k>/calibrated.yaml.
+std::filesystem::path set_calibration_file(const std::filesystem::path& run_dir, int k);
+
+// The bond parameters of calibration set k: bond_params_for for k = 1, else
+// set_calibration_file(run_dir, k), which must hold a calibration of this
+// card with the case's bond model (an error naming the file otherwise).
+BondParams bond_params_for_set(const config::CaseConfig& cfg, const std::filesystem::path& run_dir,
+                               int k);
+
 // -var pairs of the impact and lab-test decks: contacts, bonds
 // (bond_deck_vars), and the bond model's options from the case
 // (lump.broken_contact).

@@ -186,6 +186,22 @@ void breakage_json(const fs::path& run, Problems* problems, json& h) {
                    {"largest_fraction_threshold", pick(e, "threshold")}});
     h["breakage"]["critical_speed"] = c;
   }
+  // With calibrate.starts > 1: each entry's band over the parameter sets.
+  const auto sets = read_json(run / "breakage" / "calibration_sets.json", problems);
+  if (sets.is_object() && pick(sets, "entries").is_array()) {
+    json c = json::array();
+    for (const auto& e : sets.at("entries"))
+      c.push_back({{"angle_deg", pick(e, "angle_deg")},
+                   {"sets", pick(sets, "sets")},
+                   {"sets_crossing", pick(e, "sets_crossing")},
+                   {"min_m_s", pick(e, "min_m_s")},
+                   {"max_m_s", pick(e, "max_m_s")},
+                   {"sets_meeting_card", pick(e, "sets_meeting_card")},
+                   {"min_meeting_card_m_s", pick(e, "min_meeting_card_m_s")},
+                   {"max_meeting_card_m_s", pick(e, "max_meeting_card_m_s")},
+                   {"within_15_percent", pick(e, "within_15_percent")}});
+    h["breakage"]["critical_speed_over_sets"] = c;
+  }
   const auto eff = read_json(run / "breakage" / "comminution_efficiency.json", problems);
   if (eff.is_array()) {
     json c = json::array();
@@ -419,6 +435,28 @@ void breakage_rows(const json& h, const RowAdder& add) {
             d(c.at("min_m_s")) < d(c.at("max_m_s")))
           v += fmt::format(" ({}-{} over repeats)", speed(d(c.at("min_m_s"))),
                            speed(d(c.at("max_m_s"))));
+      }
+      add(3, what, v);
+    }
+  const json over_sets = pick(pick(h, "breakage"), "critical_speed_over_sets");
+  if (over_sets.is_array())
+    for (const auto& c : over_sets) {
+      std::string what = "critical impact speed over the calibration's parameter sets";
+      if (num(pick(c, "angle_deg"))) what += fmt::format(", {:g} deg", d(c.at("angle_deg")));
+      const int n = num(pick(c, "sets")) ? pick(c, "sets").get<int>() : 0;
+      const int met = num(pick(c, "sets_meeting_card")) ? pick(c, "sets_meeting_card").get<int>() : 0;
+      const int crossing = num(pick(c, "sets_crossing")) ? pick(c, "sets_crossing").get<int>() : 0;
+      std::string v = fmt::format("no set's sweep reached it ({} sets)", n);
+      if (num(pick(c, "min_m_s")) && num(pick(c, "max_m_s")))
+        v = fmt::format("{}-{} m/s over {} of {} calibrations from different starts", speed(d(c.at("min_m_s"))),
+                        speed(d(c.at("max_m_s"))), crossing, n);
+      v += met == n ? fmt::format("; all {} meet the ore card", n)
+                    : fmt::format("; {} of {} meet the ore card", met, n);
+      if (num(pick(c, "min_meeting_card_m_s")) && met < n) {
+        const std::string lo = speed(d(c.at("min_meeting_card_m_s")));
+        const std::string hi = speed(d(c.at("max_meeting_card_m_s")));
+        v += lo == hi ? fmt::format(" ({} m/s for {})", lo, met == 1 ? "that one" : "those")
+                      : fmt::format(" ({}-{} m/s over those)", lo, hi);
       }
       add(3, what, v);
     }

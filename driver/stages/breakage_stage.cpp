@@ -12,6 +12,7 @@
 #include "jobs/output_checks.h"
 #include "postprocess/impact_conditions.h"
 #include "progress.h"
+#include "stages/breakage/calibration_sets.h"
 #include "stages/breakage/campaign.h"
 #include "stages/breakage/impact_runs.h"
 #include "stages/breakage/in_mill_runs.h"
@@ -93,8 +94,12 @@ std::string BreakageStage::damaged_outputs(const StageContext& ctx, const JobSpe
 // conditions from transport), each parsed the way the report reads it.
 std::string BreakageStage::damaged_merged_outputs(const StageContext& ctx,
                                                   const std::vector<JobSpec>& jobs) const {
-  const size_t n_impacts = static_cast<size_t>(
-      std::count_if(jobs.begin(), jobs.end(), [](const JobSpec& j) { return !is_in_mill_job(j); }));
+  // The primary set's impacts make the merged tables (calibration_sets.json
+  // holds the other sets' critical speeds).
+  const size_t n_impacts =
+      static_cast<size_t>(std::count_if(jobs.begin(), jobs.end(), [](const JobSpec& j) {
+        return !is_in_mill_job(j) && calibration_set_of(j) == 1;
+      }));
   if (n_impacts == 0) return "";
   const fs::path dir = ctx.stage_dir;
   std::vector<std::string> r = {jobs::check_file(dir / "summary.csv"),
@@ -116,6 +121,9 @@ std::string BreakageStage::damaged_merged_outputs(const StageContext& ctx,
   for (const char* f : {"critical_velocity.json", "comminution_efficiency.json",
                         "size_distributions.json", "jk_fit.json"})
     r.push_back(jobs::check_json(dir / f, true));
+  if (std::any_of(jobs.begin(), jobs.end(),
+                  [](const JobSpec& j) { return calibration_set_of(j) > 1; }))
+    r.push_back(jobs::check_json(dir / "calibration_sets.json", true));
   if (ctx.cfg.doc.str("breakage.conditions") == "transport") {
     r.push_back(jobs::check_file(dir / "product.csv"));
     r.push_back(jobs::check_json(dir / "product.json", true));
@@ -143,11 +151,13 @@ Plan BreakageStage::plan(const StageContext& ctx) const {
   const nlohmann::json base = impact_base_inputs(ctx);
   if (ctx.cfg.doc.str("breakage.conditions") != "transport") {
     plan_sweep(ctx, base, p);
-    return p;
+  } else {
+    // Conditions from stage 1, and the in-mill runs, per rotor speed.
+    for (double rpm : ctx.cfg.doc.reals("rotor.rpm"))
+      if (plan_binned(ctx, base, rpm, p)) plan_in_mill(ctx, rpm, p);
   }
-  // Conditions from stage 1, and the in-mill runs, per rotor speed.
-  for (double rpm : ctx.cfg.doc.reals("rotor.rpm"))
-    if (plan_binned(ctx, base, rpm, p)) plan_in_mill(ctx, rpm, p);
+  // The same impacts with every further calibration set (calibrate.starts).
+  plan_calibration_sets(ctx, p);
   return p;
 }
 
@@ -158,14 +168,16 @@ void BreakageStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pat
   }
   const std::string line =
       run_impact(ctx, job.inputs.at("velocity").get<double>(), job.inputs.at("angle").get<double>(),
-                 job.inputs.at("repeat").get<int>(), job_dir, job.label);
+                 job.inputs.at("repeat").get<int>(), job_dir, job.label,
+                 calibration_set_of(job));
   ctx.progress.info("[breakage] " + job.label + ": " + line);
 }
 
 void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& all_jobs) {
   // The single impacts make the sweep's results; the in-mill runs their own.
-  std::vector<JobSpec> jobs, in_mill;
-  for (const auto& j : all_jobs) (is_in_mill_job(j) ? in_mill : jobs).push_back(j);
+  std::vector<JobSpec> jobs, in_mill, set_jobs;
+  for (const auto& j : all_jobs)
+    (is_in_mill_job(j) ? in_mill : calibration_set_of(j) > 1 ? set_jobs : jobs).push_back(j);
   if (jobs.empty()) return;
   // Conditions binned from transport each have their own speed and angle:
   // they are pooled into one curve over impact speed.
@@ -173,6 +185,7 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& all_
   const Campaign c = merge_impacts(ctx, jobs);
   const nlohmann::json crit = write_critical_velocity(ctx, c.rows, from_transport);
   write_comminution_efficiency(ctx, c.rows, crit);
+  write_calibration_sets(ctx, set_jobs, c.rows, crit, from_transport);
   // In the mill engineer's terms: JK A and b, passing curves in mm.
   write_size_distributions(ctx, c.fractions);
   write_jk_fit(ctx, c.rows, from_transport);

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 
@@ -20,6 +21,7 @@
 #include "stages/calibrate/outputs.h"
 #include "stages/calibrate/sensitivity.h"
 #include "stages/calibrate/specimen.h"
+#include "stages/calibrate/starts.h"
 #include "stages/stage_util.h"
 
 namespace mill {
@@ -62,7 +64,8 @@ class Calibration {
  public:
   // Targets and settings from the case and its ore card.
   Calibration(StageContext& ctx, const JobSpec& job, const fs::path& dir)
-      : ctx_(ctx),
+      : start_(start_of(job)),
+        ctx_(ctx),
         job_(job),
         dir_(dir),
         d_(ctx.cfg.doc),
@@ -79,6 +82,7 @@ class Calibration {
   void run();
 
  private:
+  int start_ = 1;  // calibrate.starts: 1 the primary fit, k >= 2 a fit from start k
   StageContext& ctx_;
   const JobSpec& job_;
   fs::path dir_;
@@ -109,7 +113,13 @@ void Calibration::run() {
   std::vector<Iteration>& hist = o.hist;
   std::vector<std::string>& notes = o.notes;
   BondParams p = estimate_bond_params(ore_, d_);
-  if (card_has_stale_calibration(ctx_.cfg)) {
+  if (start_ > 1) {
+    // A further start: the estimate scaled (calibrate/starts.h); the fit
+    // alone, the checks and sensitivities are the primary set's.
+    p = start_params(p, start_);
+    notes.push_back(p.origin);
+    ctx_.progress.info("[calibrate] " + job_.label + ": " + p.origin);
+  } else if (card_has_stale_calibration(ctx_.cfg)) {
     // A changed card: start from its previous calibration, not from scratch.
     p = read_calibrated(ore_, p);
     notes.push_back(
@@ -123,13 +133,18 @@ void Calibration::run() {
   // Steps of the job: 2 tests per iteration, the half-rate UCS (twice as
   // long), 2 tests per lever of the sensitivities (the model's levers: the
   // fit keeps the model), then the checks.
-  const CheckTargets check_for = check_targets(ore_);
-  const double n_checks = static_cast<double>(d_.reals("calibrate.confining_pressures").size()) +
+  const bool primary = start_ == 1;
+  const CheckTargets check_for = primary ? check_targets(ore_) : CheckTargets{};
+  const std::vector<double> pressures =
+      primary ? d_.reals("calibrate.confining_pressures") : std::vector<double>{};
+  const double n_checks = static_cast<double>(pressures.size()) +
                           (check_for.fracture_toughness ? 1.0 : 0.0);
-  const bool sensitivity = d_.boolean("calibrate.sensitivity");
+  const bool sensitivity = primary && d_.boolean("calibrate.sensitivity");
+  const bool rate_check = primary && d_.boolean("calibrate.rate_check");
   const double n_sensitivity =
       sensitivity ? 2.0 * static_cast<double>(sensitivity_levers(p).size()) : 0.0;
-  const double steps_total = 2.0 * max_it_ + 2.0 + n_sensitivity + n_checks;
+  const double steps_total =
+      2.0 * max_it_ + (rate_check ? 2.0 : 0.0) + n_sensitivity + n_checks;
   for (int k = 1; k <= max_it_; ++k) {
     Iteration it;
     it.p = p;
@@ -160,7 +175,7 @@ void Calibration::run() {
   }
   o.best = fit_.best(hist);
   // Rate check: the best parameters at half the strain rate.
-  if (d_.boolean("calibrate.rate_check"))
+  if (rate_check)
     o.half = lab.ucs(
         hist[o.best].p, 0.5 * rate_,
         {"rate_check_ucs", "rate check: UCS at half the strain rate", 2.0 * max_it_ / steps_total});
@@ -180,11 +195,53 @@ void Calibration::run() {
           lever_verdict(s, fit_.tolerance(), noise).free() ? "" : " (moves no target: not free)"));
     }
   }
-  o.checks = run_checks(lab, hist[o.best].p, hist[o.best].ucs, rate_,
-                        confining_pressures(d_, hist[o.best].ucs.r.ucs), check_for,
-                        (2.0 * max_it_ + 2.0 + n_sensitivity) / steps_total, 1.0 / steps_total);
+  if (primary)
+    o.checks = run_checks(lab, hist[o.best].p, hist[o.best].ucs, rate_,
+                          confining_pressures(d_, hist[o.best].ucs.r.ucs), check_for,
+                          (2.0 * max_it_ + 2.0 + n_sensitivity) / steps_total, 1.0 / steps_total);
   o.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_outputs(ctx_, dir_, fit_, o);
+}
+
+// The whole of a text file ("" when it cannot be read).
+std::string read_text(const fs::path& f) {
+  std::ifstream in(f, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// With calibrate.starts > 1: each further start's calibrated.yaml and
+// report.json under calibrate/sets/start<k>/ (where the breakage stage reads
+// them: lump/material.h), calibrate/sets.json and its table appended to
+// report.md. With one start: no sets/ folder, no sets.json.
+template <class Copy>
+void publish_sets(StageContext& ctx, const std::vector<JobSpec>& jobs, Copy copy) {
+  const fs::path dst = ctx.stage_dir;
+  fs::remove_all(dst / "sets");
+  fs::remove(dst / "sets.json");
+  if (jobs.size() < 2) return;
+  const jobs::JobStore store(ctx.stage_dir);
+  std::vector<StartResult> starts;
+  for (const auto& j : jobs) {
+    const fs::path dir = store.job_dir(j.label);
+    const nlohmann::json report = nlohmann::json::parse(read_text(dir / "report.json"));
+    const int k = start_of(j);
+    starts.push_back({k, dir, report});
+    if (k == 1) continue;
+    const fs::path to = set_calibration_file(ctx.run_dir, k);
+    fs::create_directories(to.parent_path());
+    copy(dir / "report.json", to.parent_path() / "report.json");
+    copy(dir / "calibrated.yaml", to);
+  }
+  std::sort(starts.begin(), starts.end(),
+            [](const StartResult& a, const StartResult& b) { return a.start < b.start; });
+  const nlohmann::json sets = sets_json(starts);
+  jobs::atomic_write(dst / "sets.json", sets.dump(2) + "\n");
+  if (fs::exists(dst / "report.md"))
+    jobs::atomic_write(dst / "report.md", read_text(dst / "report.md") + sets_markdown(sets));
+  ctx.progress.info(fmt::format(
+      "[calibrate] {} parameter sets from different starts, {} meeting every target of the ore "
+      "card: {}/sets.json",
+      starts.size(), sets["meeting_card"].get<int>(), dst.string()));
 }
 
 }  // namespace
@@ -193,6 +250,9 @@ void Calibration::run() {
 Plan CalibrateStage::plan(const StageContext& ctx) const {
   Plan p;
   nlohmann::json in = case_keys(ctx.cfg.doc, {"calibrate.", "lump."});
+  // The number of starts is not an input of any one fit (the primary fit
+  // keeps its job id whatever calibrate.starts is).
+  in.erase("calibrate.starts");
   in["ore"] = config::ore_keys(ctx.cfg.ore);
   for (const char* k : config::kOreCheckKeys)
     if (ctx.cfg.ore.has(k)) in["ore_checks"][k] = ctx.cfg.ore.real(k);
@@ -221,6 +281,23 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
                              : "",
                          ctx.cfg.doc.reals("calibrate.confining_pressures").size(),
                          ctx.cfg.ore.has("fracture_toughness") ? " + semi-circular bend" : "")});
+  // Further starts: the fit alone from the estimate scaled (calibrate/starts.h).
+  const int starts = static_cast<int>(ctx.cfg.doc.integer("calibrate.starts"));
+  const BondParams estimate = estimate_bond_params(ctx.cfg.ore, ctx.cfg.doc);
+  for (int k = 2; k <= starts; ++k) {
+    nlohmann::json ink = in;
+    ink.erase("from_card");
+    ink.erase("start");
+    ink["start_index"] = k;
+    ink["start"] = bond_json(start_params(estimate, k), BondNames::card);
+    const auto f = start_factors(k);
+    p.jobs.push_back(
+        {start_label(k), ink,
+         fmt::format("UCS + Brazilian tests on {} elements, fit to {} from start {} (the estimate "
+                     "x {:.3g}, {:.3g}, {:.3g}, {:.3g})",
+                     ctx.cfg.doc.integer("calibrate.n_elements"), ctx.cfg.ore.str("name"), k, f[0],
+                     f[1], f[2], f[3])});
+  }
   return p;
 }
 
@@ -258,7 +335,7 @@ std::string CalibrateStage::damaged_merged_outputs(const StageContext& ctx,
 void CalibrateStage::finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) {
   if (jobs.empty()) return;
   const jobs::JobStore store(ctx.stage_dir);
-  const fs::path src = store.job_dir(jobs.front().label), dst = ctx.stage_dir;
+  const fs::path src = store.job_dir(start_label(1)), dst = ctx.stage_dir;
   auto copy = [&](const fs::path& from, const fs::path& to) {
     std::ifstream in(from, std::ios::binary);
     if (!in) return;
@@ -277,6 +354,7 @@ void CalibrateStage::finalize(StageContext& ctx, const std::vector<JobSpec>& job
       copy(src / f, dst / f);
     else
       fs::remove(dst / f);
+  publish_sets(ctx, jobs, copy);
   copy(src / "calibrated.yaml", dst / "calibrated.yaml");
   ctx.progress.info(fmt::format("[calibrate] results: {}/calibrated.yaml, report.md, report.json{}",
                                 dst.string(), fs::exists(src / "plots") ? ", plots/*.png" : ""));

@@ -169,3 +169,18 @@ TEST(Headline, InMillProductBesideTheSingleImpacts) {
 }
 
 }  // namespace
+
+namespace {
+TEST(Headline, CriticalSpeedBandOverTheParameterSets) {
+  const json h = json::parse(R"({
+    "breakage": {"critical_speed": [{"angle_deg": null, "critical_velocity_m_s": 58.0,
+                                     "largest_fraction_threshold": 0.05}],
+                 "critical_speed_over_sets": [{"angle_deg": null, "sets": 3, "sets_crossing": 3,
+                                               "min_m_s": 52.4, "max_m_s": 63.1, "sets_meeting_card": 1,
+                                               "min_meeting_card_m_s": 58.0, "max_meeting_card_m_s": 58.0}]}})");
+  const auto rows = headline_rows(h);
+  EXPECT_EQ(value_of(rows, "critical impact speed over the calibration's parameter sets"),
+            "52-63 m/s over 3 of 3 calibrations from different starts; 1 of 3 meet the ore card "
+            "(58 m/s for that one)");
+}
+}  // namespace

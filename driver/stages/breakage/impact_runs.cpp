@@ -98,9 +98,9 @@ std::string impact_line(const nlohmann::json& r) {
 }
 
 std::string run_impact(StageContext& ctx, double velocity, double angle, int repeat,
-                       const fs::path& out_dir, const std::string& label) {
+                       const fs::path& out_dir, const std::string& label, int set) {
   const auto& d = ctx.cfg.doc;
-  const LumpRun lr = prepare_lump_run(ctx, repeat, out_dir, label);
+  const LumpRun lr = prepare_lump_run(ctx, repeat, out_dir, label, set);
   const LumpInfo& lump = lr.lump;
 
   // Start just short of contact: a gap of a tenth of an element radius.

@@ -29,8 +29,10 @@ std::string impact_line(const nlohmann::json& result);
 // One impact into `out_dir`: runs the deck, analyses the fragments and the
 // energy ledger, writes summary.csv, fractions.csv, impact.h5,
 // energy_ledger.csv, energy_ledger.png, fragments.vtp and result.json there.
-// Returns the summary line.
+// Returns the summary line. `set`: the calibration set whose bond
+// parameters the lump takes (1: the primary; calibrate.starts).
 std::string run_impact(StageContext& ctx, double velocity, double angle, int repeat,
-                       const std::filesystem::path& out_dir, const std::string& label);
+                       const std::filesystem::path& out_dir, const std::string& label,
+                       int set = 1);
 
 }  // namespace mill::breakage

@@ -33,9 +33,10 @@ struct LumpRun {
 
 // Builds (or reuses) the lump of repeat `repeat` (packing repeat mod
 // lump.n_packings), its random orientation (from lump.seed and the repeat)
-// and an empty run folder out_dir/run.
+// and an empty run folder out_dir/run, with the bond parameters of
+// calibration set `set` (1: the primary; lump/material.h).
 LumpRun prepare_lump_run(StageContext& ctx, int repeat, const std::filesystem::path& out_dir,
-                         const std::string& label);
+                         const std::string& label, int set = 1);
 
 // -var pairs every lump deck takes: the shared deck pieces' folder, the lump
 // file, its orientation, the bonding rule, the ore and the bonds.
