@@ -269,3 +269,58 @@ TEST(Fitting, TensileFirstWhenTheRatioIsOutOfReach) {
   for (const auto& n : notes) said = said || n.find("out of the levers' reach") != std::string::npos;
   EXPECT_TRUE(said);
 }
+
+// A specimen that failed at once (a negative modulus, as measured on a
+// parallel-bond fit from another start): the next parameters lie half way,
+// in log space, between the failed ones and the last usable iteration's.
+TEST(Fitting, UnusableResponseStepsBackHalfWay) {
+  const Fitting fit(kCard, 0.1);
+  BondParams bad = start();
+  bad.modulus = 4 * start().modulus;
+  bad.stiffness_ratio = start().stiffness_ratio / 4;
+  bad.tensile = start().tensile / 9;
+  bad.cohesion = start().cohesion / 9;
+  bad.moment_factor = 0.0;
+  std::vector<Iteration> hist{made(start(), 15e9, 0.17, 18e6, 4.6e6),
+                              made(bad, -0.59e9, 17.9, 2.7e6, 0.45e6)};
+  for (auto& it : hist) fit.score(it);
+  EXPECT_TRUE(Fitting::usable(hist[0]));
+  EXPECT_FALSE(Fitting::usable(hist[1]));
+  std::vector<std::string> notes;
+  const BondParams p = fit.update(hist, notes);
+  EXPECT_NEAR(p.modulus, 2 * start().modulus, 1e-6 * p.modulus);
+  EXPECT_NEAR(p.stiffness_ratio, start().stiffness_ratio / 2, 1e-12);
+  EXPECT_NEAR(p.tensile, start().tensile / 3, 1e-6);
+  EXPECT_NEAR(p.cohesion, start().cohesion / 3, 1e-6);
+  EXPECT_EQ(p.moment_factor, start().moment_factor);  // the usable iteration's lever
+  EXPECT_EQ(p.origin, "calibrate iteration 3");
+  ASSERT_FALSE(notes.empty());
+  EXPECT_NE(notes.back().find("iteration 2: no usable response"), std::string::npos)
+      << notes.back();
+  // The failed iteration is never the result.
+  EXPECT_EQ(fit.best(hist), 0u);
+}
+
+// Nothing usable yet (the first iteration failed): a named error, not a
+// secant through a negative modulus.
+TEST(Fitting, UnusableFirstIterationIsANamedError) {
+  const Fitting fit(kCard, 0.1);
+  std::vector<Iteration> hist{made(start(), -1e9, 0.2, 5e6, 1e6)};
+  fit.score(hist.back());
+  std::vector<std::string> notes;
+  try {
+    fit.update(hist, notes);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("iteration 1: the specimens gave no usable response"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// A NaN anywhere is unusable too.
+TEST(Fitting, NonFiniteResponseIsUnusable) {
+  EXPECT_FALSE(Fitting::usable(made(start(), 18e9, NAN, 50e6, 5e6)));
+  EXPECT_FALSE(Fitting::usable(made(start(), 18e9, 0.2, 50e6, 0.0)));
+  EXPECT_TRUE(Fitting::usable(made(start(), 18e9, 0.7, 50e6, 5e6)));  // nu > 0.5: damage, fittable
+}

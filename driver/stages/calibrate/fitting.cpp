@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <stdexcept>
 
 #include "postprocess/lab_tests.h"
 #include "stages/calibrate/local_model.h"
@@ -238,8 +239,51 @@ BondParams Fitting::secant_update(const std::vector<Iteration>& hist,
 // levers).
 BondParams Fitting::update(const std::vector<Iteration>& hist,
                            std::vector<std::string>& notes) const {
-  return hist.back().p.model == BondModel::flat_joint ? joint_update(hist, notes)
-                                                      : secant_update(hist, notes);
+  std::vector<Iteration> good;
+  for (const auto& it : hist)
+    if (usable(it)) good.push_back(it);
+  const Iteration& last = hist.back();
+  if (!usable(last)) {
+    // A response no model can use: step back half way (in log space) from
+    // this iteration's parameters towards the last usable iteration's, with
+    // that iteration's coarse levers; a line search of the step that failed.
+    if (good.empty())
+      throw std::runtime_error(fmt::format(
+          "iteration {}: the specimens gave no usable response (E {:.3g} GPa, nu {:.3g}, UCS "
+          "{:.3g} MPa, tensile {:.3g} MPa) and no earlier iteration did: the fit has nothing to "
+          "step back to; start from other bond parameters (calibrate.starts, or the ore card's "
+          "calibrated: section)",
+          hist.size(), last.ucs.r.youngs_modulus / 1e9, last.ucs.r.poisson_ratio,
+          last.ucs.r.ucs / 1e6, last.br.r.tensile_strength / 1e6));
+    const BondParams& g = good.back().p;
+    BondParams p = g;
+    // Halfway from the failed parameters towards the last usable ones: a
+    // second failure in a row halves the step again.
+    const BondParams& b = last.p;
+    p.modulus = std::sqrt(g.modulus * b.modulus);
+    p.stiffness_ratio = std::sqrt(g.stiffness_ratio * b.stiffness_ratio);
+    p.tensile = std::sqrt(g.tensile * b.tensile);
+    p.cohesion = std::sqrt(g.cohesion * b.cohesion);
+    p.origin = "calibrate iteration " + std::to_string(hist.size() + 1);
+    notes.push_back(fmt::format(
+        "iteration {}: no usable response (E {:.3g} GPa, UCS {:.3g} MPa, tensile {:.3g} MPa): "
+        "stepped back half way towards the parameters of the last usable iteration",
+        hist.size(), last.ucs.r.youngs_modulus / 1e9, last.ucs.r.ucs / 1e6,
+        last.br.r.tensile_strength / 1e6));
+    return p;
+  }
+  // The steps see the usable iterations only (their notes count those).
+  BondParams p = last.p.model == BondModel::flat_joint ? joint_update(good, notes)
+                                                       : secant_update(good, notes);
+  p.origin = "calibrate iteration " + std::to_string(hist.size() + 1);
+  return p;
+}
+
+bool Fitting::usable(const Iteration& it) {
+  const double E = it.ucs.r.youngs_modulus, nu = it.ucs.r.poisson_ratio, ucs = it.ucs.r.ucs,
+               t = it.br.r.tensile_strength;
+  return std::isfinite(E) && std::isfinite(nu) && std::isfinite(ucs) && std::isfinite(t) &&
+         E > 0 && ucs > 0 && t > 0;
 }
 
 // The best iteration: most targets within tolerance, then the smallest

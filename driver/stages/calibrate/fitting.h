@@ -79,6 +79,10 @@ class Fitting {
                           std::vector<std::string>& notes) const;
   // Index of the iteration kept as the result.
   size_t best(const std::vector<Iteration>& hist) const;
+  // True when an iteration's responses can be fitted: E, UCS and the
+  // tensile strength finite and > 0, nu finite (a specimen that failed at
+  // once can give a negative modulus).
+  static bool usable(const Iteration& it);
 
  private:
   Targets t_;
