@@ -29,6 +29,11 @@ namespace {
 
 constexpr double kRadToDeg = 57.295779513082320876;
 constexpr int kMaxSurfaces = 16;
+// The pre-filter's grid: at most this many bins per triangle, and at most
+// this many bin entries (triangle indices) per triangle; the bins grow until
+// both hold.
+constexpr double kBinsPerTriangle = 4.0;
+constexpr double kEntriesPerTriangle = 32.0;
 
 // Small 3-vector helpers: dot product, difference, cross product c = a x b.
 inline double dot3(const double *a, const double *b) {
@@ -149,8 +154,9 @@ FixImpactRecorder::~FixImpactRecorder() {
   if (ends_file_) fclose(ends_file_);
 }
 
-// Reads `fix ID group impact/recorder file F [ends F2] surface NAME mesh MESHID
-// [omega w origin x y z axis x y z] [surface ...]`; errors name key and value.
+// Reads `fix ID group impact/recorder file F [ends F2] [prefilter yes|no]
+// surface NAME mesh MESHID [omega w origin x y z axis x y z] [surface ...]`;
+// errors name key and value.
 void FixImpactRecorder::parse_args(int narg, char **arg) {
   auto fail = [this](const std::string &msg) {
     const std::string m = "fix impact/recorder: " + msg;
@@ -171,6 +177,12 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
       need(iarg, 1, key);
       ends_path_ = arg[iarg + 1];
       iarg += 2;
+    } else if (key == "prefilter") {
+      need(iarg, 1, key);
+      const std::string v = arg[iarg + 1];
+      if (v != "yes" && v != "no") fail("prefilter must be yes or no, got '" + v + "'");
+      prefilter_ = v == "yes";
+      iarg += 2;
     } else if (key == "surface") {
       need(iarg, 3, key);
       if (std::strcmp(arg[iarg + 2], "mesh") != 0)
@@ -182,7 +194,8 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
       iarg += 4;
       bool have_omega = false, have_origin = false, have_axis = false;
       while (iarg < narg && std::strcmp(arg[iarg], "surface") != 0 &&
-             std::strcmp(arg[iarg], "file") != 0 && std::strcmp(arg[iarg], "ends") != 0) {
+             std::strcmp(arg[iarg], "file") != 0 && std::strcmp(arg[iarg], "ends") != 0 &&
+             std::strcmp(arg[iarg], "prefilter") != 0) {
         const std::string sub = arg[iarg];
         if (sub == "omega") {
           need(iarg, 1, sub);
@@ -197,7 +210,7 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
           iarg += 4;
         } else {
           fail("surface " + s.name + ": unknown keyword '" + sub +
-               "' (expected omega, origin, axis, surface, file, ends)");
+               "' (expected omega, origin, axis, surface, file, ends, prefilter)");
         }
       }
       if (have_omega || have_origin || have_axis) {
@@ -211,7 +224,7 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
       }
       surfaces_.push_back(s);
     } else {
-      fail("unknown keyword '" + key + "' (expected file, ends, surface)");
+      fail("unknown keyword '" + key + "' (expected file, ends, prefilter, surface)");
     }
   }
   if (file_path_.empty()) fail("keyword 'file' (the impact CSV) is required");
@@ -257,6 +270,7 @@ void FixImpactRecorder::setup(int /*vflag*/) {
   double **x = atom->x;
   const double *radius = atom->radius;
   const int *mask = atom->mask;
+  set_query_reach();
   for (auto &s : surfaces_) {
     load_triangles(s);
     set_bound(s);
@@ -276,7 +290,7 @@ void FixImpactRecorder::setup(int /*vflag*/) {
 }
 
 // Copies the current (moved) triangles of a mesh, owned and ghost, with their
-// unit normals and bounding box.
+// unit normals and bounding box, and bins them (with the pre-filter on).
 void FixImpactRecorder::load_triangles(Surface &s) {
   AbstractMesh *m = s.mesh->mesh();
   const int n = m->size();
@@ -300,6 +314,124 @@ void FixImpactRecorder::load_triangles(Surface &s) {
     for (int d = 0; d < 3; ++d) s.normal[3 * t + d] = len > 0.0 ? nrm[d] / len : 0.0;
   }
   s.loaded = true;
+  s.grid_reach = -1.0;
+  if (prefilter_) build_grid(s);
+}
+
+// The largest radius nearest_point is asked for this step on this rank: the
+// largest radius of the group's atoms, twice that with contact ends
+// (record_end looks for the surface within two radii).
+void FixImpactRecorder::set_query_reach() {
+  const double *radius = atom->radius;
+  const int *mask = atom->mask;
+  double r = 0.0;
+  for (int i = 0; i < atom->nlocal; ++i)
+    if ((mask[i] & groupbit) && radius[i] > r) r = radius[i];
+  query_reach_ = ends_path_.empty() ? r : 2.0 * r;
+}
+
+// Bins the triangles of s into a uniform grid: each triangle goes into every
+// bin that its bounding box, grown by this step's query reach (plus a margin
+// far above rounding), meets, so that a triangle within the reach of a point
+// is always among the triangles of the point's bin. Bins are cubes sized for
+// about kBinsPerTriangle bins per triangle, and grow while the entries pass
+// kEntriesPerTriangle per triangle (large triangles over small bins).
+void FixImpactRecorder::build_grid(Surface &s) {
+  const int n = static_cast<int>(s.normal.size() / 3);
+  if (n == 0) return;  // no triangles here: the box test already says no contact
+  double ext[3], lo[3], widest = 0.0, far = 0.0;
+  for (int d = 0; d < 3; ++d) {
+    widest = std::max(widest, s.box[2 * d + 1] - s.box[2 * d]);
+    far = std::max({far, std::fabs(s.box[2 * d]), std::fabs(s.box[2 * d + 1])});
+  }
+  const double pad = query_reach_ * (1.0 + 1e-9) + 1e-9 * (widest + far);
+  for (int d = 0; d < 3; ++d) {
+    lo[d] = s.box[2 * d] - pad;
+    ext[d] = s.box[2 * d + 1] + pad - lo[d];
+  }
+  const double max_cells = std::max(1.0, kBinsPerTriangle * n);
+  const double max_entries = kEntriesPerTriangle * n;
+  double h = std::cbrt(ext[0] * ext[1] * ext[2] / max_cells);
+  if (!(h > 0.0) || !std::isfinite(h)) return;  // a degenerate surface: test all triangles
+  // Bins of the grown box of triangle t along d at bin size h: [i0, i1].
+  auto range = [&](int t, int d, int nd, int &i0, int &i1) {
+    const double *p = &s.tri[9 * static_cast<size_t>(t)];
+    const double tlo = std::min({p[d], p[3 + d], p[6 + d]}) - pad;
+    const double thi = std::max({p[d], p[3 + d], p[6 + d]}) + pad;
+    i0 = std::clamp(static_cast<int>(std::floor((tlo - lo[d]) / h)), 0, nd - 1);
+    i1 = std::clamp(static_cast<int>(std::floor((thi - lo[d]) / h)), 0, nd - 1);
+  };
+  int nb[3];
+  for (;;) {
+    double cells = 1.0;
+    for (int d = 0; d < 3; ++d) {
+      nb[d] = std::max(1, static_cast<int>(std::ceil(ext[d] / h)));
+      cells *= nb[d];
+    }
+    if (cells > max_cells) {
+      h *= 1.25;
+      continue;
+    }
+    double entries = 0.0;
+    for (int t = 0; t < n && entries <= max_entries; ++t) {
+      double k = 1.0;
+      for (int d = 0; d < 3; ++d) {
+        int i0, i1;
+        range(t, d, nb[d], i0, i1);
+        k *= i1 - i0 + 1;
+      }
+      entries += k;
+    }
+    if (entries <= max_entries || cells <= 1.0) break;
+    h *= 1.25;
+  }
+  const size_t ncell = static_cast<size_t>(nb[0]) * nb[1] * nb[2];
+  s.cell_start.assign(ncell + 1, 0);
+  // Two passes, count then fill, in ascending triangle order: every bin's
+  // list comes out ascending, the order the full loop tests them in.
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<int> next;
+    if (pass == 1) {
+      for (size_t b = 0; b < ncell; ++b) s.cell_start[b + 1] += s.cell_start[b];
+      s.cell_tri.resize(static_cast<size_t>(s.cell_start[ncell]));
+      next.assign(s.cell_start.begin(), s.cell_start.end() - 1);
+    }
+    for (int t = 0; t < n; ++t) {
+      int r0[3], r1[3];
+      for (int d = 0; d < 3; ++d) range(t, d, nb[d], r0[d], r1[d]);
+      for (int i = r0[0]; i <= r1[0]; ++i)
+        for (int j = r0[1]; j <= r1[1]; ++j)
+          for (int k = r0[2]; k <= r1[2]; ++k) {
+            const size_t b = (static_cast<size_t>(k) * nb[1] + j) * nb[0] + i;
+            if (pass == 0)
+              ++s.cell_start[b + 1];
+            else
+              s.cell_tri[static_cast<size_t>(next[b]++)] = t;
+          }
+    }
+  }
+  for (int d = 0; d < 3; ++d) {
+    s.grid_lo[d] = lo[d];
+    s.grid_n[d] = nb[d];
+  }
+  s.grid_h = h;
+  s.grid_reach = query_reach_;
+}
+
+// The triangles of the bin holding x, as [*first, *last); false if x lies
+// outside the grid (then no triangle is within the grid's reach of it).
+bool FixImpactRecorder::grid_candidates(const Surface &s, const double *x, const int **first,
+                                        const int **last) const {
+  int ib[3];
+  for (int d = 0; d < 3; ++d) {
+    const double f = std::floor((x[d] - s.grid_lo[d]) / s.grid_h);
+    if (!(f >= 0.0 && f < s.grid_n[d])) return false;
+    ib[d] = static_cast<int>(f);
+  }
+  const size_t b = (static_cast<size_t>(ib[2]) * s.grid_n[1] + ib[1]) * s.grid_n[0] + ib[0];
+  *first = s.cell_tri.data() + s.cell_start[b];
+  *last = s.cell_tri.data() + s.cell_start[b + 1];
+  return true;
 }
 
 // A sphere that holds the whole surface at every rotation angle (about the
@@ -343,7 +475,10 @@ void FixImpactRecorder::set_bound(Surface &s) {
 }
 
 // Nearest point c of the surface to x if closer than radius (contact); false
-// otherwise. Triangles whose plane is farther than radius are skipped cheaply.
+// otherwise. Only the triangles of x's bin are tested (with the pre-filter;
+// all of them without), in ascending order, so the first of equally near
+// triangles wins either way; triangles whose plane is farther than radius
+// are skipped cheaply.
 bool FixImpactRecorder::nearest_point(Surface &s, const double *x, double radius, double *c) {
   double dc[3];
   sub3(x, s.bound.data(), dc);
@@ -352,14 +487,13 @@ bool FixImpactRecorder::nearest_point(Surface &s, const double *x, double radius
   if (!s.loaded) load_triangles(s);  // first particle near this surface this step
   for (int d = 0; d < 3; ++d)
     if (x[d] < s.box[2 * d] - radius || x[d] > s.box[2 * d + 1] + radius) return false;
-  const size_t n = s.normal.size() / 3;
   double best = radius * radius;
   bool found = false;
-  for (size_t t = 0; t < n; ++t) {
+  auto test = [&](size_t t) {
     const double *p = &s.tri[9 * t];
     double ap[3];
     sub3(x, p, ap);
-    if (std::fabs(dot3(ap, &s.normal[3 * t])) >= radius) continue;
+    if (std::fabs(dot3(ap, &s.normal[3 * t])) >= radius) return;
     double q[3];
     closest_on_triangle(x, p, p + 3, p + 6, q);
     double dq[3];
@@ -370,7 +504,15 @@ bool FixImpactRecorder::nearest_point(Surface &s, const double *x, double radius
       for (int k = 0; k < 3; ++k) c[k] = q[k];
       found = true;
     }
+  };
+  if (s.grid_reach >= radius) {
+    const int *first = nullptr, *last = nullptr;
+    if (!grid_candidates(s, x, &first, &last)) return false;
+    for (const int *t = first; t != last; ++t) test(static_cast<size_t>(*t));
+    return found;
   }
+  const size_t n = s.normal.size() / 3;  // no grid, or a radius beyond its reach
+  for (size_t t = 0; t < n; ++t) test(t);
   return found;
 }
 
@@ -491,6 +633,7 @@ void FixImpactRecorder::end_of_step() {
   double **x = atom->x;
   const double *radius = atom->radius;
   const int *mask = atom->mask;
+  if (prefilter_) set_query_reach();
   for (auto &s : surfaces_) s.loaded = false;  // triangles are fetched lazily
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
@@ -609,6 +752,8 @@ int FixImpactRecorder::unpack_exchange(int nlocal, double *buf) {
 
 double FixImpactRecorder::memory_usage() {
   double bytes = static_cast<double>(nmax_) * ncols_ * sizeof(double);
-  for (const auto &s : surfaces_) bytes += (s.tri.size() + s.normal.size()) * sizeof(double);
+  for (const auto &s : surfaces_)
+    bytes += (s.tri.size() + s.normal.size()) * sizeof(double) +
+             (s.cell_start.size() + s.cell_tri.size()) * sizeof(int);
   return bytes;
 }

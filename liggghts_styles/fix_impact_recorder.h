@@ -105,13 +105,24 @@ class FixImpactRecorder : public Fix {
     std::vector<double> normal;             // 3 doubles per triangle (unit)
     std::array<double, 6> box{};            // bounding box of the triangles
     std::array<double, 4> bound{};  // sphere holding the surface at any angle: centre, radius
-    bool loaded = false;            // tri, normal, box are this step's
+    bool loaded = false;            // tri, normal, box (and grid) are this step's
+    // The pre-filter: a uniform grid of bins over the triangles' boxes grown
+    // by `reach`; bin b holds the triangles whose grown box meets it, in
+    // ascending index order, in cell_tri[cell_start[b] .. cell_start[b + 1]).
+    std::array<double, 3> grid_lo{};  // corner of bin (0, 0, 0)       [m]
+    std::array<int, 3> grid_n{0, 0, 0};
+    double grid_h = 0.0;       // bin edge                          [m]
+    double grid_reach = -1.0;  // largest radius the grid answers (< 0: no grid)
+    std::vector<int> cell_start;
+    std::vector<int> cell_tri;
   };
   std::vector<Surface> surfaces_;
   std::string file_path_;
   FILE *file_ = nullptr;       // rank 0 only
   std::string ends_path_;      // contact_ends CSV ("" = no end records)
   FILE *ends_file_ = nullptr;  // rank 0 only
+  bool prefilter_ = true;      // test only the triangles of the particle's bin
+  double query_reach_ = 0.0;   // largest query radius this step on this rank [m]
 
   // Cached counts (read by compute_vector): total, then one per surface.
   std::vector<double> counts_;
@@ -127,8 +138,12 @@ class FixImpactRecorder : public Fix {
 
   void parse_args(int narg, char **arg);
   void load_triangles(Surface &s);
+  void set_query_reach();
+  void build_grid(Surface &s);
   void set_bound(Surface &s);
   bool nearest_point(Surface &s, const double *x, double radius, double *c);
+  bool grid_candidates(const Surface &s, const double *x, const int **first,
+                       const int **last) const;
   void surface_velocity(const Surface &s, const double *c, double *w, double *raxis) const;
   void record(const Surface &s, int is, int i, const double *c);
   void record_end(Surface &s, int is, int i, double start);
