@@ -114,6 +114,11 @@ FixImpactRecorder::FixImpactRecorder(LAMMPS *lmp, int narg, char **arg) : Fix(lm
   counts_.assign(size_vector, 0.0);
 
   ncols_ = 1 + static_cast<int>(surfaces_.size());
+  if (pending_from_ >= 0) {
+    peratom_flag = 1;
+    size_peratom_cols = 0;
+    peratom_freq = 1;
+  }
   grow_arrays(atom->nmax);
   atom->add_callback(0);
 
@@ -150,13 +155,14 @@ FixImpactRecorder::FixImpactRecorder(LAMMPS *lmp, int narg, char **arg) : Fix(lm
 FixImpactRecorder::~FixImpactRecorder() {
   atom->delete_callback(id, 0);
   memory->destroy(state_);
+  memory->destroy(pending_);
   if (file_) fclose(file_);
   if (ends_file_) fclose(ends_file_);
 }
 
 // Reads `fix ID group impact/recorder file F [ends F2] [prefilter yes|no]
-// surface NAME mesh MESHID [omega w origin x y z axis x y z] [surface ...]`;
-// errors name key and value.
+// [pending FROM TO] surface NAME mesh MESHID [omega w origin x y z axis x y z]
+// [surface ...]`; errors name key and value.
 void FixImpactRecorder::parse_args(int narg, char **arg) {
   auto fail = [this](const std::string &msg) {
     const std::string m = "fix impact/recorder: " + msg;
@@ -183,6 +189,11 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
       if (v != "yes" && v != "no") fail("prefilter must be yes or no, got '" + v + "'");
       prefilter_ = v == "yes";
       iarg += 2;
+    } else if (key == "pending") {
+      need(iarg, 2, key);
+      pending_names_[0] = arg[iarg + 1];
+      pending_names_[1] = arg[iarg + 2];
+      iarg += 3;
     } else if (key == "surface") {
       need(iarg, 3, key);
       if (std::strcmp(arg[iarg + 2], "mesh") != 0)
@@ -195,7 +206,7 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
       bool have_omega = false, have_origin = false, have_axis = false;
       while (iarg < narg && std::strcmp(arg[iarg], "surface") != 0 &&
              std::strcmp(arg[iarg], "file") != 0 && std::strcmp(arg[iarg], "ends") != 0 &&
-             std::strcmp(arg[iarg], "prefilter") != 0) {
+             std::strcmp(arg[iarg], "prefilter") != 0 && std::strcmp(arg[iarg], "pending") != 0) {
         const std::string sub = arg[iarg];
         if (sub == "omega") {
           need(iarg, 1, sub);
@@ -210,7 +221,7 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
           iarg += 4;
         } else {
           fail("surface " + s.name + ": unknown keyword '" + sub +
-               "' (expected omega, origin, axis, surface, file, ends, prefilter)");
+               "' (expected omega, origin, axis, surface, file, ends, prefilter, pending)");
         }
       }
       if (have_omega || have_origin || have_axis) {
@@ -224,7 +235,7 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
       }
       surfaces_.push_back(s);
     } else {
-      fail("unknown keyword '" + key + "' (expected file, ends, prefilter, surface)");
+      fail("unknown keyword '" + key + "' (expected file, ends, prefilter, pending, surface)");
     }
   }
   if (file_path_.empty()) fail("keyword 'file' (the impact CSV) is required");
@@ -235,6 +246,19 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
   if (surfaces_.size() > static_cast<size_t>(kMaxSurfaces))
     fail("at most " + std::to_string(kMaxSurfaces) + " surfaces, got " +
          std::to_string(surfaces_.size()));
+  if (!pending_names_[0].empty()) {
+    std::string names;
+    for (const auto &s : surfaces_) names += (names.empty() ? "" : ", ") + s.name;
+    int *index[2] = {&pending_from_, &pending_to_};
+    for (int k = 0; k < 2; ++k) {
+      for (size_t is = 0; is < surfaces_.size(); ++is)
+        if (surfaces_[is].name == pending_names_[k]) *index[k] = static_cast<int>(is);
+      if (*index[k] < 0)
+        fail("pending: no surface named '" + pending_names_[k] + "' (the surfaces: " + names + ")");
+    }
+    if (pending_from_ == pending_to_)
+      fail("pending: FROM and TO must be two surfaces, got '" + pending_names_[0] + "' twice");
+  }
 }
 
 int FixImpactRecorder::setmask() {
@@ -637,7 +661,7 @@ void FixImpactRecorder::end_of_step() {
   for (auto &s : surfaces_) s.loaded = false;  // triangles are fetched lazily
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
-    int bits = static_cast<int>(state_[i][0]);
+    int bits = static_cast<int>(state_[i][0]), onsets = 0;
     for (size_t is = 0; is < surfaces_.size(); ++is) {
       double c[3];
       const int bit = 1 << is;
@@ -645,6 +669,7 @@ void FixImpactRecorder::end_of_step() {
         if (!(bits & bit)) {
           record(surfaces_[is], static_cast<int>(is), i, c);
           state_[i][1 + is] = update->get_cur_time();
+          onsets |= bit;
         }
         bits |= bit;
       } else {
@@ -655,6 +680,12 @@ void FixImpactRecorder::end_of_step() {
       }
     }
     state_[i][0] = bits;
+    if (pending_from_ >= 0) {  // an onset on TO in the same step as one on FROM: arrived
+      if (onsets & (1 << pending_to_))
+        pending_[i] = 0.0;
+      else if (onsets & (1 << pending_from_))
+        pending_[i] = 1.0;
+    }
   }
   flush_events();
 }
@@ -722,36 +753,47 @@ double FixImpactRecorder::compute_vector(int n) {
   return n >= 0 && n < static_cast<int>(counts_.size()) ? counts_[n] : 0.0;
 }
 
-// Per-atom contact bits and onset times (grow, copy, set, pack and unpack
-// list the same ncols_ columns in the same order).
+// Per-atom contact bits and onset times, then (with `pending`) the pending
+// flag: grow, copy, set, pack and unpack list the same columns in the same
+// order.
 void FixImpactRecorder::grow_arrays(int nmax) {
   memory->grow(state_, nmax, ncols_, "impact/recorder:state");
+  if (pending_from_ >= 0) {
+    memory->grow(pending_, nmax, "impact/recorder:pending");
+    vector_atom = pending_;
+  }
   for (int i = nmax_; i < nmax; ++i) set_arrays(i);
   nmax_ = nmax;
 }
 
 void FixImpactRecorder::copy_arrays(int i, int j, int /*delflag*/) {
   for (int k = 0; k < ncols_; ++k) state_[j][k] = state_[i][k];
+  if (pending_) pending_[j] = pending_[i];
 }
 
-// A new atom starts without contacts.
+// A new atom starts without contacts, not pending.
 void FixImpactRecorder::set_arrays(int i) {
   state_[i][0] = 0.0;
   for (int k = 1; k < ncols_; ++k) state_[i][k] = -1.0;
+  if (pending_) pending_[i] = 0.0;
 }
 
 int FixImpactRecorder::pack_exchange(int i, double *buf) {
   for (int k = 0; k < ncols_; ++k) buf[k] = state_[i][k];
-  return ncols_;
+  if (!pending_) return ncols_;
+  buf[ncols_] = pending_[i];
+  return ncols_ + 1;
 }
 
 int FixImpactRecorder::unpack_exchange(int nlocal, double *buf) {
   for (int k = 0; k < ncols_; ++k) state_[nlocal][k] = buf[k];
-  return ncols_;
+  if (!pending_) return ncols_;
+  pending_[nlocal] = buf[ncols_];
+  return ncols_ + 1;
 }
 
 double FixImpactRecorder::memory_usage() {
-  double bytes = static_cast<double>(nmax_) * ncols_ * sizeof(double);
+  double bytes = static_cast<double>(nmax_) * (ncols_ + (pending_ ? 1 : 0)) * sizeof(double);
   for (const auto &s : surfaces_)
     bytes += (s.tri.size() + s.normal.size()) * sizeof(double) +
              (s.cell_start.size() + s.cell_tri.size()) * sizeof(int);

@@ -8,7 +8,9 @@
 // meshes: the distance from the particle centre to the nearest triangle is
 // below the radius. A per-atom bit per surface remembers "in contact" so that
 // only onsets are recorded, and the onset time per surface lets the end
-// record name its contact; both travel with the atom between ranks.
+// record name its contact; both travel with the atom between ranks. With
+// `pending FROM TO` a per-atom flag is 1 while the atom's latest onset on
+// FROM is later than its latest onset on TO (struck, not yet arrived).
 #ifndef MILL_FIX_IMPACT_RECORDER_H
 #define MILL_FIX_IMPACT_RECORDER_H
 
@@ -118,11 +120,13 @@ class FixImpactRecorder : public Fix {
   };
   std::vector<Surface> surfaces_;
   std::string file_path_;
-  FILE *file_ = nullptr;       // rank 0 only
-  std::string ends_path_;      // contact_ends CSV ("" = no end records)
-  FILE *ends_file_ = nullptr;  // rank 0 only
-  bool prefilter_ = true;      // test only the triangles of the particle's bin
-  double query_reach_ = 0.0;   // largest query radius this step on this rank [m]
+  FILE *file_ = nullptr;                     // rank 0 only
+  std::string ends_path_;                    // contact_ends CSV ("" = no end records)
+  FILE *ends_file_ = nullptr;                // rank 0 only
+  bool prefilter_ = true;                    // test only the triangles of the particle's bin
+  std::string pending_names_[2];             // `pending FROM TO` ("" = none)
+  int pending_from_ = -1, pending_to_ = -1;  // their surface indices
+  double query_reach_ = 0.0;                 // largest query radius this step on this rank [m]
 
   // Cached counts (read by compute_vector): total, then one per surface.
   std::vector<double> counts_;
@@ -133,6 +137,7 @@ class FixImpactRecorder : public Fix {
   int nmax_ = 0;
   int ncols_ = 1;
   double **state_ = nullptr;
+  double *pending_ = nullptr;   // per atom, with `pending`: the flag (the per-atom output)
   std::vector<double> events_;  // this step's onsets on this rank, NCOL per event
   std::vector<double> ends_;    // this step's contact ends on this rank, NEND per event
 
