@@ -29,6 +29,11 @@ namespace {
 
 constexpr double kRadToDeg = 57.295779513082320876;
 constexpr int kMaxSurfaces = 16;
+// The pre-filter's grid: at most this many bins per triangle, and at most
+// this many bin entries (triangle indices) per triangle; the bins grow until
+// both hold.
+constexpr double kBinsPerTriangle = 4.0;
+constexpr double kEntriesPerTriangle = 32.0;
 
 // Small 3-vector helpers: dot product, difference, cross product c = a x b.
 inline double dot3(const double *a, const double *b) {
@@ -109,6 +114,11 @@ FixImpactRecorder::FixImpactRecorder(LAMMPS *lmp, int narg, char **arg) : Fix(lm
   counts_.assign(size_vector, 0.0);
 
   ncols_ = 1 + static_cast<int>(surfaces_.size());
+  if (pending_from_ >= 0) {
+    peratom_flag = 1;
+    size_peratom_cols = 0;
+    peratom_freq = 1;
+  }
   grow_arrays(atom->nmax);
   atom->add_callback(0);
 
@@ -145,12 +155,14 @@ FixImpactRecorder::FixImpactRecorder(LAMMPS *lmp, int narg, char **arg) : Fix(lm
 FixImpactRecorder::~FixImpactRecorder() {
   atom->delete_callback(id, 0);
   memory->destroy(state_);
+  memory->destroy(pending_);
   if (file_) fclose(file_);
   if (ends_file_) fclose(ends_file_);
 }
 
-// Reads `fix ID group impact/recorder file F [ends F2] surface NAME mesh MESHID
-// [omega w origin x y z axis x y z] [surface ...]`; errors name key and value.
+// Reads `fix ID group impact/recorder file F [ends F2] [prefilter yes|no]
+// [pending FROM TO] surface NAME mesh MESHID [omega w origin x y z axis x y z]
+// [surface ...]`; errors name key and value.
 void FixImpactRecorder::parse_args(int narg, char **arg) {
   auto fail = [this](const std::string &msg) {
     const std::string m = "fix impact/recorder: " + msg;
@@ -171,6 +183,17 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
       need(iarg, 1, key);
       ends_path_ = arg[iarg + 1];
       iarg += 2;
+    } else if (key == "prefilter") {
+      need(iarg, 1, key);
+      const std::string v = arg[iarg + 1];
+      if (v != "yes" && v != "no") fail("prefilter must be yes or no, got '" + v + "'");
+      prefilter_ = v == "yes";
+      iarg += 2;
+    } else if (key == "pending") {
+      need(iarg, 2, key);
+      pending_names_[0] = arg[iarg + 1];
+      pending_names_[1] = arg[iarg + 2];
+      iarg += 3;
     } else if (key == "surface") {
       need(iarg, 3, key);
       if (std::strcmp(arg[iarg + 2], "mesh") != 0)
@@ -182,7 +205,8 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
       iarg += 4;
       bool have_omega = false, have_origin = false, have_axis = false;
       while (iarg < narg && std::strcmp(arg[iarg], "surface") != 0 &&
-             std::strcmp(arg[iarg], "file") != 0 && std::strcmp(arg[iarg], "ends") != 0) {
+             std::strcmp(arg[iarg], "file") != 0 && std::strcmp(arg[iarg], "ends") != 0 &&
+             std::strcmp(arg[iarg], "prefilter") != 0 && std::strcmp(arg[iarg], "pending") != 0) {
         const std::string sub = arg[iarg];
         if (sub == "omega") {
           need(iarg, 1, sub);
@@ -197,7 +221,7 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
           iarg += 4;
         } else {
           fail("surface " + s.name + ": unknown keyword '" + sub +
-               "' (expected omega, origin, axis, surface, file, ends)");
+               "' (expected omega, origin, axis, surface, file, ends, prefilter, pending)");
         }
       }
       if (have_omega || have_origin || have_axis) {
@@ -211,7 +235,7 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
       }
       surfaces_.push_back(s);
     } else {
-      fail("unknown keyword '" + key + "' (expected file, ends, surface)");
+      fail("unknown keyword '" + key + "' (expected file, ends, prefilter, pending, surface)");
     }
   }
   if (file_path_.empty()) fail("keyword 'file' (the impact CSV) is required");
@@ -222,6 +246,19 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
   if (surfaces_.size() > static_cast<size_t>(kMaxSurfaces))
     fail("at most " + std::to_string(kMaxSurfaces) + " surfaces, got " +
          std::to_string(surfaces_.size()));
+  if (!pending_names_[0].empty()) {
+    std::string names;
+    for (const auto &s : surfaces_) names += (names.empty() ? "" : ", ") + s.name;
+    int *index[2] = {&pending_from_, &pending_to_};
+    for (int k = 0; k < 2; ++k) {
+      for (size_t is = 0; is < surfaces_.size(); ++is)
+        if (surfaces_[is].name == pending_names_[k]) *index[k] = static_cast<int>(is);
+      if (*index[k] < 0)
+        fail("pending: no surface named '" + pending_names_[k] + "' (the surfaces: " + names + ")");
+    }
+    if (pending_from_ == pending_to_)
+      fail("pending: FROM and TO must be two surfaces, got '" + pending_names_[0] + "' twice");
+  }
 }
 
 int FixImpactRecorder::setmask() {
@@ -257,6 +294,7 @@ void FixImpactRecorder::setup(int /*vflag*/) {
   double **x = atom->x;
   const double *radius = atom->radius;
   const int *mask = atom->mask;
+  set_query_reach();
   for (auto &s : surfaces_) {
     load_triangles(s);
     set_bound(s);
@@ -276,7 +314,7 @@ void FixImpactRecorder::setup(int /*vflag*/) {
 }
 
 // Copies the current (moved) triangles of a mesh, owned and ghost, with their
-// unit normals and bounding box.
+// unit normals and bounding box, and bins them (with the pre-filter on).
 void FixImpactRecorder::load_triangles(Surface &s) {
   AbstractMesh *m = s.mesh->mesh();
   const int n = m->size();
@@ -300,6 +338,124 @@ void FixImpactRecorder::load_triangles(Surface &s) {
     for (int d = 0; d < 3; ++d) s.normal[3 * t + d] = len > 0.0 ? nrm[d] / len : 0.0;
   }
   s.loaded = true;
+  s.grid_reach = -1.0;
+  if (prefilter_) build_grid(s);
+}
+
+// The largest radius nearest_point is asked for this step on this rank: the
+// largest radius of the group's atoms, twice that with contact ends
+// (record_end looks for the surface within two radii).
+void FixImpactRecorder::set_query_reach() {
+  const double *radius = atom->radius;
+  const int *mask = atom->mask;
+  double r = 0.0;
+  for (int i = 0; i < atom->nlocal; ++i)
+    if ((mask[i] & groupbit) && radius[i] > r) r = radius[i];
+  query_reach_ = ends_path_.empty() ? r : 2.0 * r;
+}
+
+// Bins the triangles of s into a uniform grid: each triangle goes into every
+// bin that its bounding box, grown by this step's query reach (plus a margin
+// far above rounding), meets, so that a triangle within the reach of a point
+// is always among the triangles of the point's bin. Bins are cubes sized for
+// about kBinsPerTriangle bins per triangle, and grow while the entries pass
+// kEntriesPerTriangle per triangle (large triangles over small bins).
+void FixImpactRecorder::build_grid(Surface &s) {
+  const int n = static_cast<int>(s.normal.size() / 3);
+  if (n == 0) return;  // no triangles here: the box test already says no contact
+  double ext[3], lo[3], widest = 0.0, far = 0.0;
+  for (int d = 0; d < 3; ++d) {
+    widest = std::max(widest, s.box[2 * d + 1] - s.box[2 * d]);
+    far = std::max({far, std::fabs(s.box[2 * d]), std::fabs(s.box[2 * d + 1])});
+  }
+  const double pad = query_reach_ * (1.0 + 1e-9) + 1e-9 * (widest + far);
+  for (int d = 0; d < 3; ++d) {
+    lo[d] = s.box[2 * d] - pad;
+    ext[d] = s.box[2 * d + 1] + pad - lo[d];
+  }
+  const double max_cells = std::max(1.0, kBinsPerTriangle * n);
+  const double max_entries = kEntriesPerTriangle * n;
+  double h = std::cbrt(ext[0] * ext[1] * ext[2] / max_cells);
+  if (!(h > 0.0) || !std::isfinite(h)) return;  // a degenerate surface: test all triangles
+  // Bins of the grown box of triangle t along d at bin size h: [i0, i1].
+  auto range = [&](int t, int d, int nd, int &i0, int &i1) {
+    const double *p = &s.tri[9 * static_cast<size_t>(t)];
+    const double tlo = std::min({p[d], p[3 + d], p[6 + d]}) - pad;
+    const double thi = std::max({p[d], p[3 + d], p[6 + d]}) + pad;
+    i0 = std::clamp(static_cast<int>(std::floor((tlo - lo[d]) / h)), 0, nd - 1);
+    i1 = std::clamp(static_cast<int>(std::floor((thi - lo[d]) / h)), 0, nd - 1);
+  };
+  int nb[3];
+  for (;;) {
+    double cells = 1.0;
+    for (int d = 0; d < 3; ++d) {
+      nb[d] = std::max(1, static_cast<int>(std::ceil(ext[d] / h)));
+      cells *= nb[d];
+    }
+    if (cells > max_cells) {
+      h *= 1.25;
+      continue;
+    }
+    double entries = 0.0;
+    for (int t = 0; t < n && entries <= max_entries; ++t) {
+      double k = 1.0;
+      for (int d = 0; d < 3; ++d) {
+        int i0, i1;
+        range(t, d, nb[d], i0, i1);
+        k *= i1 - i0 + 1;
+      }
+      entries += k;
+    }
+    if (entries <= max_entries || cells <= 1.0) break;
+    h *= 1.25;
+  }
+  const size_t ncell = static_cast<size_t>(nb[0]) * nb[1] * nb[2];
+  s.cell_start.assign(ncell + 1, 0);
+  // Two passes, count then fill, in ascending triangle order: every bin's
+  // list comes out ascending, the order the full loop tests them in.
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<int> next;
+    if (pass == 1) {
+      for (size_t b = 0; b < ncell; ++b) s.cell_start[b + 1] += s.cell_start[b];
+      s.cell_tri.resize(static_cast<size_t>(s.cell_start[ncell]));
+      next.assign(s.cell_start.begin(), s.cell_start.end() - 1);
+    }
+    for (int t = 0; t < n; ++t) {
+      int r0[3], r1[3];
+      for (int d = 0; d < 3; ++d) range(t, d, nb[d], r0[d], r1[d]);
+      for (int i = r0[0]; i <= r1[0]; ++i)
+        for (int j = r0[1]; j <= r1[1]; ++j)
+          for (int k = r0[2]; k <= r1[2]; ++k) {
+            const size_t b = (static_cast<size_t>(k) * nb[1] + j) * nb[0] + i;
+            if (pass == 0)
+              ++s.cell_start[b + 1];
+            else
+              s.cell_tri[static_cast<size_t>(next[b]++)] = t;
+          }
+    }
+  }
+  for (int d = 0; d < 3; ++d) {
+    s.grid_lo[d] = lo[d];
+    s.grid_n[d] = nb[d];
+  }
+  s.grid_h = h;
+  s.grid_reach = query_reach_;
+}
+
+// The triangles of the bin holding x, as [*first, *last); false if x lies
+// outside the grid (then no triangle is within the grid's reach of it).
+bool FixImpactRecorder::grid_candidates(const Surface &s, const double *x, const int **first,
+                                        const int **last) const {
+  int ib[3];
+  for (int d = 0; d < 3; ++d) {
+    const double f = std::floor((x[d] - s.grid_lo[d]) / s.grid_h);
+    if (!(f >= 0.0 && f < s.grid_n[d])) return false;
+    ib[d] = static_cast<int>(f);
+  }
+  const size_t b = (static_cast<size_t>(ib[2]) * s.grid_n[1] + ib[1]) * s.grid_n[0] + ib[0];
+  *first = s.cell_tri.data() + s.cell_start[b];
+  *last = s.cell_tri.data() + s.cell_start[b + 1];
+  return true;
 }
 
 // A sphere that holds the whole surface at every rotation angle (about the
@@ -343,7 +499,10 @@ void FixImpactRecorder::set_bound(Surface &s) {
 }
 
 // Nearest point c of the surface to x if closer than radius (contact); false
-// otherwise. Triangles whose plane is farther than radius are skipped cheaply.
+// otherwise. Only the triangles of x's bin are tested (with the pre-filter;
+// all of them without), in ascending order, so the first of equally near
+// triangles wins either way; triangles whose plane is farther than radius
+// are skipped cheaply.
 bool FixImpactRecorder::nearest_point(Surface &s, const double *x, double radius, double *c) {
   double dc[3];
   sub3(x, s.bound.data(), dc);
@@ -352,14 +511,13 @@ bool FixImpactRecorder::nearest_point(Surface &s, const double *x, double radius
   if (!s.loaded) load_triangles(s);  // first particle near this surface this step
   for (int d = 0; d < 3; ++d)
     if (x[d] < s.box[2 * d] - radius || x[d] > s.box[2 * d + 1] + radius) return false;
-  const size_t n = s.normal.size() / 3;
   double best = radius * radius;
   bool found = false;
-  for (size_t t = 0; t < n; ++t) {
+  auto test = [&](size_t t) {
     const double *p = &s.tri[9 * t];
     double ap[3];
     sub3(x, p, ap);
-    if (std::fabs(dot3(ap, &s.normal[3 * t])) >= radius) continue;
+    if (std::fabs(dot3(ap, &s.normal[3 * t])) >= radius) return;
     double q[3];
     closest_on_triangle(x, p, p + 3, p + 6, q);
     double dq[3];
@@ -370,7 +528,15 @@ bool FixImpactRecorder::nearest_point(Surface &s, const double *x, double radius
       for (int k = 0; k < 3; ++k) c[k] = q[k];
       found = true;
     }
+  };
+  if (s.grid_reach >= radius) {
+    const int *first = nullptr, *last = nullptr;
+    if (!grid_candidates(s, x, &first, &last)) return false;
+    for (const int *t = first; t != last; ++t) test(static_cast<size_t>(*t));
+    return found;
   }
+  const size_t n = s.normal.size() / 3;  // no grid, or a radius beyond its reach
+  for (size_t t = 0; t < n; ++t) test(t);
   return found;
 }
 
@@ -491,10 +657,11 @@ void FixImpactRecorder::end_of_step() {
   double **x = atom->x;
   const double *radius = atom->radius;
   const int *mask = atom->mask;
+  if (prefilter_) set_query_reach();
   for (auto &s : surfaces_) s.loaded = false;  // triangles are fetched lazily
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
-    int bits = static_cast<int>(state_[i][0]);
+    int bits = static_cast<int>(state_[i][0]), onsets = 0;
     for (size_t is = 0; is < surfaces_.size(); ++is) {
       double c[3];
       const int bit = 1 << is;
@@ -502,6 +669,7 @@ void FixImpactRecorder::end_of_step() {
         if (!(bits & bit)) {
           record(surfaces_[is], static_cast<int>(is), i, c);
           state_[i][1 + is] = update->get_cur_time();
+          onsets |= bit;
         }
         bits |= bit;
       } else {
@@ -512,6 +680,12 @@ void FixImpactRecorder::end_of_step() {
       }
     }
     state_[i][0] = bits;
+    if (pending_from_ >= 0) {  // an onset on TO in the same step as one on FROM: arrived
+      if (onsets & (1 << pending_to_))
+        pending_[i] = 0.0;
+      else if (onsets & (1 << pending_from_))
+        pending_[i] = 1.0;
+    }
   }
   flush_events();
 }
@@ -579,36 +753,49 @@ double FixImpactRecorder::compute_vector(int n) {
   return n >= 0 && n < static_cast<int>(counts_.size()) ? counts_[n] : 0.0;
 }
 
-// Per-atom contact bits and onset times (grow, copy, set, pack and unpack
-// list the same ncols_ columns in the same order).
+// Per-atom contact bits and onset times, then (with `pending`) the pending
+// flag: grow, copy, set, pack and unpack list the same columns in the same
+// order.
 void FixImpactRecorder::grow_arrays(int nmax) {
   memory->grow(state_, nmax, ncols_, "impact/recorder:state");
+  if (pending_from_ >= 0) {
+    memory->grow(pending_, nmax, "impact/recorder:pending");
+    vector_atom = pending_;
+  }
   for (int i = nmax_; i < nmax; ++i) set_arrays(i);
   nmax_ = nmax;
 }
 
 void FixImpactRecorder::copy_arrays(int i, int j, int /*delflag*/) {
   for (int k = 0; k < ncols_; ++k) state_[j][k] = state_[i][k];
+  if (pending_) pending_[j] = pending_[i];
 }
 
-// A new atom starts without contacts.
+// A new atom starts without contacts, not pending.
 void FixImpactRecorder::set_arrays(int i) {
   state_[i][0] = 0.0;
   for (int k = 1; k < ncols_; ++k) state_[i][k] = -1.0;
+  if (pending_) pending_[i] = 0.0;
 }
 
 int FixImpactRecorder::pack_exchange(int i, double *buf) {
   for (int k = 0; k < ncols_; ++k) buf[k] = state_[i][k];
-  return ncols_;
+  if (!pending_) return ncols_;
+  buf[ncols_] = pending_[i];
+  return ncols_ + 1;
 }
 
 int FixImpactRecorder::unpack_exchange(int nlocal, double *buf) {
   for (int k = 0; k < ncols_; ++k) state_[nlocal][k] = buf[k];
-  return ncols_;
+  if (!pending_) return ncols_;
+  pending_[nlocal] = buf[ncols_];
+  return ncols_ + 1;
 }
 
 double FixImpactRecorder::memory_usage() {
-  double bytes = static_cast<double>(nmax_) * ncols_ * sizeof(double);
-  for (const auto &s : surfaces_) bytes += (s.tri.size() + s.normal.size()) * sizeof(double);
+  double bytes = static_cast<double>(nmax_) * (ncols_ + (pending_ ? 1 : 0)) * sizeof(double);
+  for (const auto &s : surfaces_)
+    bytes += (s.tri.size() + s.normal.size()) * sizeof(double) +
+             (s.cell_start.size() + s.cell_tri.size()) * sizeof(int);
   return bytes;
 }

@@ -8,7 +8,9 @@
 // meshes: the distance from the particle centre to the nearest triangle is
 // below the radius. A per-atom bit per surface remembers "in contact" so that
 // only onsets are recorded, and the onset time per surface lets the end
-// record name its contact; both travel with the atom between ranks.
+// record name its contact; both travel with the atom between ranks. With
+// `pending FROM TO` a per-atom flag is 1 while the atom's latest onset on
+// FROM is later than its latest onset on TO (struck, not yet arrived).
 #ifndef MILL_FIX_IMPACT_RECORDER_H
 #define MILL_FIX_IMPACT_RECORDER_H
 
@@ -105,13 +107,26 @@ class FixImpactRecorder : public Fix {
     std::vector<double> normal;             // 3 doubles per triangle (unit)
     std::array<double, 6> box{};            // bounding box of the triangles
     std::array<double, 4> bound{};  // sphere holding the surface at any angle: centre, radius
-    bool loaded = false;            // tri, normal, box are this step's
+    bool loaded = false;            // tri, normal, box (and grid) are this step's
+    // The pre-filter: a uniform grid of bins over the triangles' boxes grown
+    // by `reach`; bin b holds the triangles whose grown box meets it, in
+    // ascending index order, in cell_tri[cell_start[b] .. cell_start[b + 1]).
+    std::array<double, 3> grid_lo{};  // corner of bin (0, 0, 0)       [m]
+    std::array<int, 3> grid_n{0, 0, 0};
+    double grid_h = 0.0;       // bin edge                          [m]
+    double grid_reach = -1.0;  // largest radius the grid answers (< 0: no grid)
+    std::vector<int> cell_start;
+    std::vector<int> cell_tri;
   };
   std::vector<Surface> surfaces_;
   std::string file_path_;
-  FILE *file_ = nullptr;       // rank 0 only
-  std::string ends_path_;      // contact_ends CSV ("" = no end records)
-  FILE *ends_file_ = nullptr;  // rank 0 only
+  FILE *file_ = nullptr;                     // rank 0 only
+  std::string ends_path_;                    // contact_ends CSV ("" = no end records)
+  FILE *ends_file_ = nullptr;                // rank 0 only
+  bool prefilter_ = true;                    // test only the triangles of the particle's bin
+  std::string pending_names_[2];             // `pending FROM TO` ("" = none)
+  int pending_from_ = -1, pending_to_ = -1;  // their surface indices
+  double query_reach_ = 0.0;                 // largest query radius this step on this rank [m]
 
   // Cached counts (read by compute_vector): total, then one per surface.
   std::vector<double> counts_;
@@ -122,13 +137,18 @@ class FixImpactRecorder : public Fix {
   int nmax_ = 0;
   int ncols_ = 1;
   double **state_ = nullptr;
+  double *pending_ = nullptr;   // per atom, with `pending`: the flag (the per-atom output)
   std::vector<double> events_;  // this step's onsets on this rank, NCOL per event
   std::vector<double> ends_;    // this step's contact ends on this rank, NEND per event
 
   void parse_args(int narg, char **arg);
   void load_triangles(Surface &s);
+  void set_query_reach();
+  void build_grid(Surface &s);
   void set_bound(Surface &s);
   bool nearest_point(Surface &s, const double *x, double radius, double *c);
+  bool grid_candidates(const Surface &s, const double *x, const int **first,
+                       const int **last) const;
   void surface_velocity(const Surface &s, const double *c, double *w, double *raxis) const;
   void record(const Surface &s, int is, int i, const double *c);
   void record_end(Surface &s, int is, int i, double start);

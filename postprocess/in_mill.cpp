@@ -162,4 +162,29 @@ MassPlaces LocateMass(const std::vector<Element>& elements, const MillRegions& g
   return m;
 }
 
+InMillStop ReadInMillStop(const std::string& log_path) {
+  std::ifstream in(log_path);
+  if (!in) throw PostError(log_path + ": cannot open the LIGGGHTS log");
+  InMillStop stop;
+  bool found = false;
+  std::string line;
+  const std::string head = "in_mill: stopped at t = ";
+  while (std::getline(in, line)) {
+    if (line.rfind(head, 0) != 0) continue;
+    std::istringstream ls(line.substr(head.size()));
+    double t = 0;
+    std::string unit, reason;
+    if (!(ls >> t >> unit >> reason) || unit != "s" || reason.size() < 3 || reason.front() != '(' ||
+        reason.back() != ')')
+      throw PostError(fmt::format("{}: expected '{}T s (REASON)', got '{}'", log_path, head, line));
+    stop.time_s = t;
+    stop.reason = reason.substr(1, reason.size() - 2);
+    found = true;
+  }
+  if (!found)
+    throw PostError(fmt::format("{}: no '{}T s (REASON)' line: the in-mill deck did not finish",
+                                log_path, head));
+  return stop;
+}
+
 }  // namespace mill::post

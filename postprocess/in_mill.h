@@ -95,4 +95,15 @@ struct MassPlaces {
 };
 MassPlaces LocateMass(const std::vector<Element>& elements, const MillRegions& regions);
 
+// How an in-mill run ended, from the deck's last line
+// "in_mill: stopped at t = T s (REASON)" in its LIGGGHTS log: REASON is
+// "work_done" (the early stop's conditions held at the end of a chunk) or
+// "t_end" (the run lasted its duration). Throws PostError naming the log
+// when it holds no such line.
+struct InMillStop {
+  double time_s = 0;
+  std::string reason;
+};
+InMillStop ReadInMillStop(const std::string& log_path);
+
 }  // namespace mill::post

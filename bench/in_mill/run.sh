@@ -2,6 +2,7 @@
 # In-mill breakage benchmark; figures go to bench/README.md.
 #   bench/in_mill/run.sh [build-dir]
 #   DURATION=0.005 bench/in_mill/run.sh      a shorter run (s) for comparing settings
+#   LEAD_TIME=5e-5 DURATION=2.5e-4 ...        a run that starts closer to the strike (s)
 # The reference lump (3344 elements, the reference calibration's bonds) in the
 # reference mill at 2000 rpm for 20 ms on one core: stage 1's impact record is
 # one strike written here (the lump falling at 10 m/s onto plate 0's leading
@@ -45,8 +46,9 @@ open(f"{out}/calibrate/calibrated.yaml", "w").write(
     f"  input_hash: {h:016x}\n")
 PY
 case_file="$here/reference_in_mill.yaml"
-if [ -n "${DURATION:-}" ]; then
-  sed "s/duration: 0.02,/duration: $DURATION,/" "$case_file" > "$out.case.yaml"
+if [ -n "${DURATION:-}${LEAD_TIME:-}" ]; then
+  sed -e "s/duration: 0.02,/duration: ${DURATION:-0.02},/" \
+      -e "s/lead_time: 2.0e-3,/lead_time: ${LEAD_TIME:-2.0e-3},/" "$case_file" > "$out.case.yaml"
   case_file="$out.case.yaml"
 fi
 /usr/bin/time -v "$build/bin/orchestrate" --case "$case_file" --stage breakage --task 1 \

@@ -390,6 +390,13 @@ std::vector<KeyDef> breakage_keys() {
           key("breakage.in_mill.gas", T::Bool, "", "true",
               "In-mill breakage: gas drag on each element from the sampled field (sample stage); "
               "false = no gas"),
+          key("breakage.in_mill.early_stop", T::Bool, "", "true",
+              "In-mill breakage: end a run before duration, at the end of a 0.25 ms chunk, once "
+              "the strike is over: an element has touched the flywheel or the housing, no "
+              "element is within the tip radius plus one lump diameter of the axis (nor gets "
+              "there within a chunk at its speed towards the axis), and every element whose "
+              "latest flywheel contact came after its latest housing contact has left the "
+              "housing (docs/breakage.md); false = every run lasts duration"),
           at_least(key("breakage.in_mill.neighbour_bins", T::Int, "", "4000000",
                        "In-mill breakage: most neighbour bins over the simulation box, which holds "
                        "the whole mill "

@@ -4,7 +4,12 @@
 // while the second in-mill run is going, and resumed. Then: the struck lump
 // broke at the strike, the other only against the housing (and the record
 // says none broke at the strike), element mass is conserved, and
-// product.json and in_mill.csv hold the in-mill product.
+// product.json and in_mill.csv hold the in-mill product. The early stop
+// (breakage.in_mill.early_stop, on by default): the lump that flies past the
+// rotor into the housing stops at the end of the first chunk after it has
+// reached the housing, well before the 8 ms; the struck lump's fragments are
+// still in the rotor region at 8 ms (they are struck again and again for
+// over 30 ms on this small mill), so it runs to the end.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -126,6 +131,22 @@ TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAK
   EXPECT_EQ(missed.at("flywheel").at("contacts").get<long>(), 0) << missed.dump(2);
   EXPECT_EQ(missed.at("bonds_broken_at_strike").get<long>(), 0) << missed.dump(2);
   EXPECT_GT(missed.at("housing").at("contacts").get<long>(), 0) << missed.dump(2);
+  // The early stop: each run says when and why it stopped.
+  const auto& gone = missed.at("stop");
+  EXPECT_EQ(gone.at("reason").get<std::string>(), "work_done") << missed.dump(2);
+  EXPECT_TRUE(gone.at("early_stop").get<bool>());
+  EXPECT_LT(gone.at("time_s").get<double>(), 8.0e-3 - 2.5e-4) << missed.dump(2);
+  EXPECT_GT(gone.at("time_s").get<double>(), missed.at("first_housing_contact_s").get<double>())
+      << missed.dump(2);
+  EXPECT_EQ(missed.at("mass_places").at("rotor").get<double>(), 0.0) << missed.dump(2);
+  const auto& busy = struck.at("stop");
+  EXPECT_EQ(busy.at("reason").get<std::string>(), "t_end") << struck.dump(2);
+  EXPECT_GE(busy.at("time_s").get<double>(), 8.0e-3 - 1e-9) << struck.dump(2);
+  EXPECT_GT(struck.at("mass_places").at("rotor").get<double>(), 0.0) << struck.dump(2);
+  for (const char* l : {"rpm2000_mill_p1", "rpm2000_mill_p2"}) {
+    const std::string log = slurp(stage / "jobs" / l / "run/liggghts.log");
+    EXPECT_NE(log.find("in_mill: stopped at t = "), std::string::npos) << l;
+  }
   // The energy ledger of each run: the struck lump's broken bonds took part of
   // the energy given (the rotor's work included); the balance closes.
   EXPECT_GT(struck.at("energy").at("comminution_efficiency").get<double>(), 0.0) << struck.dump(2);
@@ -188,6 +209,10 @@ TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAK
   int rows = 0;
   while (std::getline(csv, line)) ++rows;
   EXPECT_EQ(rows, 3);  // header and two runs
+  const std::string table = slurp(stage / "in_mill.csv");
+  EXPECT_NE(table.find(",stop_time_s,stop_reason\n"), std::string::npos) << table;
+  EXPECT_NE(table.find(",work_done\n"), std::string::npos) << table;
+  EXPECT_NE(table.find(",t_end\n"), std::string::npos) << table;
 
   // The report's headline has the in-mill row beside the single impact's.
   ASSERT_EQ(orchestrate("--case " + yaml + " --stage report --output " + dir.string(),
@@ -202,7 +227,8 @@ TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAK
 // With gas: still air of 1.2 kg/m3 over the tiny housing (a field where the
 // sample stage puts it); the run takes the drag and says so. One lump of the
 // two is chosen: the one of the median strike normal speed, lump 2 (41.9 m/s
-// against 35.7), the one the beater cannot reach.
+// against 35.7), the one the beater cannot reach. With the early stop off
+// it runs its whole 4 ms, and its record says so.
 TEST(InMill, GasDragFromTheSampledField) {
   const fs::path dir = scratch("in_mill_gas");
   write_transport_impacts(dir);
@@ -216,7 +242,8 @@ TEST(InMill, GasDragFromTheSampledField) {
   const std::string from = "in_mill: {lumps: 2, duration: 8.0e-3, lead_time: 2.0e-3, gas: false}";
   ASSERT_NE(yaml.find(from), std::string::npos);
   yaml.replace(yaml.find(from), from.size(),
-               "in_mill: {lumps: 1, duration: 4.0e-3, lead_time: 2.0e-3, gas: true}");
+               "in_mill: {lumps: 1, duration: 4.0e-3, lead_time: 2.0e-3, gas: true, "
+               "early_stop: false}");
   spit(dir / "case.yaml", yaml);
   ASSERT_EQ(orchestrate("--case " + (dir / "case.yaml").string() + " --stage breakage --output " +
                             dir.string(),
@@ -225,6 +252,9 @@ TEST(InMill, GasDragFromTheSampledField) {
       << slurp(dir / "run.log");
   const auto j = nlohmann::json::parse(slurp(dir / "breakage/jobs/rpm2000_mill_p2/in_mill.json"));
   EXPECT_TRUE(j.at("gas").get<bool>());
+  EXPECT_FALSE(j.at("stop").at("early_stop").get<bool>()) << j.dump(2);
+  EXPECT_EQ(j.at("stop").at("reason").get<std::string>(), "t_end") << j.dump(2);
+  EXPECT_GE(j.at("stop").at("time_s").get<double>(), 4.0e-3 - 1e-9) << j.dump(2);
   EXPECT_EQ(j.at("bonds_broken_at_strike").get<long>(), 0) << j.dump(2);
   // Still air only takes energy from the lump, and it took some.
   EXPECT_LT(j.at("energy").at("work_gas_J").get<double>(), 0.0) << j.dump(2);

@@ -416,3 +416,59 @@ TEST(ImpactRecorder, MissingFileIsNamed) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.screen.find("'file'"), std::string::npos) << r.screen;
 }
+
+// `pending floor wall`: a sphere thrown down at a floor (y = 0) bounces off
+// it and flies on to a wall (x = 0.05 m). The per-atom flag, summed by a
+// compute, is 0 before the floor strike, 1 between the strike and the wall
+// impact, and 0 after it; on two ranks (split at x = 0) the sphere crosses
+// to rank 1 after the strike, so the flag must travel with it.
+TEST(ImpactRecorder, PendingFromStrikeToWall) {
+  for (int np = 1; np <= 2; ++np) {
+    const std::string dir = make_run_dir("pending" + std::to_string(np));
+    const double f0[3] = {-0.5, 0, 0.5}, f1[3] = {1, 0, 0}, f2[3] = {0, 0, -1};
+    write_rect_stl(dir + "/floor.stl", f0, f1, f2);
+    const double w0[3] = {0.05, -0.5, 0.5}, w1[3] = {0, 1, 0}, w2[3] = {0, 0, -1};
+    write_rect_stl(dir + "/wall.stl", w0, w1, w2);
+    std::string head = deck_head(0.6);
+    if (np == 2) head.insert(head.find("region box"), "processors 2 1 1\n");
+    std::ostringstream s;
+    s.precision(17);
+    s << head << "fix floor all mesh/surface file floor.stl type 1\n"
+      << "fix wall all mesh/surface file wall.stl type 1\n"
+      << "fix walls all wall/gran model hertz tangential history mesh n_meshes 2 meshes floor "
+         "wall\n"
+      << "create_atoms 1 single -0.008 0.012 0 units box\n"
+      << "set group all diameter 0.02 density 2500\n"
+      << "velocity all set 10 -3 0 units box\n"
+      << "fix integr all nve/sphere\n"
+      << "fix rec all impact/recorder file impacts.csv pending floor wall surface floor mesh "
+         "floor surface wall mesh wall\n"
+      << "variable p atom f_rec\ncompute np all reduce sum v_p\n"
+      << "variable np_now equal c_np\nvariable x1 equal x[1]\n"
+      << "thermo_style custom step c_np f_rec[2] f_rec[3]\n"
+      << "timestep 1e-6\nthermo 1000\n"
+      << "run 500\nprint \"pending: ${np_now} before\"\n"
+      << "run 1000\nprint \"pending: ${np_now} between, x ${x1}\"\n"
+      << "run 8000\nprint \"pending: ${np_now} after\"\n";
+    const auto r = run_deck(dir, s.str(), np);
+    ASSERT_EQ(r.exit_code, 0) << r.screen;
+    for (const char *want : {"pending: 0 before", "pending: 1 between, x 0.0", "pending: 0 after"})
+      EXPECT_NE(r.screen.find(want), std::string::npos) << np << " rank(s): " << want << "\n"
+                                                        << r.screen;
+  }
+}
+
+// `pending` must name two of the fix's surfaces.
+TEST(ImpactRecorder, PendingUnknownSurfaceIsNamed) {
+  const std::string dir = make_run_dir("pendingerr");
+  const double p0[3] = {-0.05, 0, 0.05}, e1[3] = {0.1, 0, 0}, e2[3] = {0, 0, -0.1};
+  write_rect_stl(dir + "/plane.stl", p0, e1, e2);
+  const auto r = run_deck(
+      dir, deck_head(0.1) + "fix plane all mesh/surface file plane.stl type 1\n" +
+               "fix rec all impact/recorder file impacts.csv pending beater floor surface floor "
+               "mesh plane\nrun 0\n");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.screen.find("pending: no surface named 'beater' (the surfaces: floor)"),
+            std::string::npos)
+      << r.screen;
+}

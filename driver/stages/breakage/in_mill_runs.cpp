@@ -28,7 +28,7 @@ using post::kPi;
 constexpr double kG = 9.81;
 // Bumped whenever the in-mill deck changes what a run gives (git log of this
 // line: what each version changed).
-constexpr int kInMillDeckVersion = 4;
+constexpr int kInMillDeckVersion = 5;
 // Facets of the flywheel's hub circle in the in-mill runs (see run_in_mill).
 constexpr int kHubFacets = 24;
 // Neighbour skin in mean element radii: the turning flywheel forces a list
@@ -70,7 +70,9 @@ const std::vector<std::string>& csv_columns() {
                                              "mass_housing",
                                              "mass_outlet",
                                              "mass_inlet",
-                                             "wall_seconds"};
+                                             "wall_seconds",
+                                             "stop_time_s",
+                                             "stop_reason"};
   return c;
 }
 
@@ -105,6 +107,7 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan) {
                                    "breakage.in_mill.duration",
                                    "breakage.in_mill.lead_time",
                                    "breakage.in_mill.gas",
+                                   "breakage.in_mill.early_stop",
                                    "breakage.in_mill.neighbour_bins",
                                    "transport.sliding_threshold"};
   if (gas)
@@ -159,9 +162,10 @@ fs::path gas_field(const StageContext& ctx, const std::string& label, double rpm
 geometry::MillGeometry run_geometry(const config::Document& d, const nlohmann::json& in) {
   geometry::MillGeometry g = geometry::MillGeometry::from_config(d);
   g.rotor_angle = in.at("rotor_angle_rad").get<double>();
-  // The hub circle drawn with kHubFacets instead of 96 facets: the impact
-  // recorder tests every element against every facet at each step (816
-  // facets took half the run time); the polygon departs from the circle by
+  // The hub circle drawn with kHubFacets instead of 96 facets: chosen when
+  // the impact recorder tested every element against every facet (816
+  // facets took half the run time; its pre-filter now tests only the facets
+  // near an element); the polygon departs from the circle by
   // r (1 - cos(pi / kHubFacets)), 1.3 mm on a 0.3 m hub.
   g.arc_segments = kHubFacets;
   return g;
@@ -232,7 +236,11 @@ std::vector<std::pair<std::string, std::string>> in_mill_vars(
       {"gas", gas ? "1" : "0"},
       {"field_file", gas ? fs::absolute(field_file).string() : std::string("none")},
       {"viscosity", num(d.real("gas.viscosity"))},
+      {"tip_radius", num(g.tip_radius())},
+      {"housing_top", num(g.height)},
       {"t_end", num(d.real("breakage.in_mill.duration"))},
+      {"early_stop", d.boolean("breakage.in_mill.early_stop") ? "1" : "0"},
+      {"stop_margin", num(d.real("lump.diameter"))},
       {"dt", num(d.real("breakage.timestep"))},
       {"dt_speed", num(step.dt_speed)},
       {"skin", num(kSkinRadii * lr.lump.mean_radius)},
@@ -260,8 +268,9 @@ void check_inside_walls(const LumpRunResult& a, const geometry::MillGeometry& g,
 }
 
 // The record of a run: its contacts, the bonds broken at the strike and
-// later, where the mass ended.
+// later, where the mass ended, when and why the run stopped.
 struct MillRecord {
+  post::InMillStop stop;
   post::BreakSplit split;
   post::ContactTally fly, wall;
   post::MassPlaces mass;
@@ -270,6 +279,7 @@ struct MillRecord {
 
 MillRecord read_record(const LumpRun& lr, const LumpRunResult& a, const geometry::MillGeometry& g) {
   MillRecord r;
+  r.stop = post::ReadInMillStop((lr.work / "liggghts.log").string());
   const auto contacts = post::ReadImpactsCsv((lr.work / "impacts.csv").string());
   r.split = post::SplitBreaks(post::ReadBreakLog((lr.work / "breaks.txt").string()), contacts);
   r.fly = post::TallyContacts(contacts, "flywheel");
@@ -314,6 +324,16 @@ void add_in_mill_keys(nlohmann::json& j, const config::Document& d, const nlohma
                  {"normal_speed_m_s", in.at("strike_normal_speed_m_s")},
                  {"angle_deg", in.at("strike_angle_deg").get<double>()}};
   j["duration_s"] = d.real("breakage.in_mill.duration");
+  j["stop"] = {
+      {"time_s", r.stop.time_s},
+      {"reason", r.stop.reason},
+      {"early_stop", d.boolean("breakage.in_mill.early_stop")},
+      {"definition",
+       "work_done: at the end of a chunk an element had touched the flywheel or the housing, "
+       "no element was within the tip radius plus one lump diameter of the axis or would get "
+       "there within a chunk at its speed towards the axis, and every element whose latest "
+       "flywheel contact came after its latest housing contact had left the housing; t_end: "
+       "the run lasted duration_s"}};
   j["gas"] = d.boolean("breakage.in_mill.gas");
   j["element_mass_kg"] = r.element_mass;
   j["bonds_broken_at_strike"] = r.split.at_strike;
@@ -341,12 +361,13 @@ std::string in_mill_line(const nlohmann::json& in, const LumpRunResult& a, const
       "{:.1f}%{}; bonds broken "
       "{:.1f}% ({} at the strike, {} later); {} flywheel and {} housing contacts; mass in the "
       "rotor region {:.0f}%, "
-      "housing {:.0f}%, below the floor {:.0f}% [{:.1f} s]",
+      "housing {:.0f}%, below the floor {:.0f}%; stopped at {:.2f} ms ({}) [{:.1f} s]",
       in.at("particle_id").get<long long>(), in.at("strike_speed_m_s").get<double>(),
       in.at("strike_angle_deg").get<double>(), s.n_pieces, s.n_single,
       100 * s.largest_mass_fraction, s.t10_percent, s.t10_resolved ? "" : " (unresolved)",
       100 * s.broken_bond_fraction, r.split.at_strike, r.split.later, r.fly.n, r.wall.n,
-      100 * r.mass.rotor, 100 * r.mass.housing, 100 * r.mass.outlet, seconds);
+      100 * r.mass.rotor, 100 * r.mass.housing, 100 * r.mass.outlet, 1e3 * r.stop.time_s,
+      r.stop.reason, seconds);
 }
 
 }  // namespace
@@ -379,7 +400,12 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
       ctx, lr, {in.at("strike_speed_m_s").get<double>(), std::clamp(a_strike, 0.0, 90.0), repeat},
       res.seconds, label);
   check_inside_walls(a, g, lr, label);
-  const MillRecord record = read_record(lr, a, g);
+  MillRecord record;
+  try {
+    record = read_record(lr, a, g);
+  } catch (const post::PostError& e) {
+    throw std::runtime_error(fmt::format("{}: {}", label, e.what()));
+  }
 
   nlohmann::json j = lump_result_json(lr, a, res.seconds);
   add_in_mill_keys(j, d, in, record);
@@ -436,7 +462,7 @@ std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
     csv += fmt::format(
         "{:g},{},{},{:.9g},{:.6g},{:.6g},{},{},{},{:.9g},{:.9g},{:.6g},{},{:.9g},{},{},{},{},{:.6g}"
         ",{:.6g},"
-        "{:.6g},{:.6g},{:.6g},{:.3f}\n",
+        "{:.6g},{:.6g},{:.6g},{:.3f},{:.9g},{}\n",
         rpm, job.label, j.at("start").at("particle_id").get<long long>(),
         j.at("start").at("strike_time_in_transport_s").get<double>(),
         j.at("strike").at("speed_m_s").get<double>(), j.at("strike").at("angle_deg").get<double>(),
@@ -450,7 +476,8 @@ std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
         j.at("housing").at("contacts").get<long long>(),
         j.at("housing").at("normal_speed_mean_m_s").get<double>(), m.at("rotor").get<double>(),
         m.at("housing").get<double>(), m.at("outlet").get<double>(), m.at("inlet").get<double>(),
-        j.at("wall_seconds").get<double>());
+        j.at("wall_seconds").get<double>(), j.at("stop").at("time_s").get<double>(),
+        j.at("stop").at("reason").get<std::string>());
   }
   std::map<double, nlohmann::json> out;
   if (by_rpm.empty()) return out;
@@ -475,6 +502,7 @@ std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
           {"outlet", a.outlet / n},
           {"inlet", a.inlet / n}}},
         {"duration_s", ctx.cfg.doc.real("breakage.in_mill.duration")},
+        {"early_stop", ctx.cfg.doc.boolean("breakage.in_mill.early_stop")},
         {"note",
          "bonded lumps run in the turning mill from their first flywheel strike in stage 1: "
          "the strike, the flight and the housing impacts (breakage/in_mill.csv per run)"}};
