@@ -50,8 +50,9 @@ LocalModelPrior flat_joint_prior() {
   LocalModelPrior m;
   // Rows: ln E, nu, ln UCS, ln T; columns: ln E_b, ln kn/ks, ln sigma_b,
   // ln c/sigma_b. Measured: the lever sensitivities of the sandstone's
-  // flat-joint calibration (default specimens, bond gap 1.0, Nov 25;
-  // bench/README.md, "The joint step of the fit"), each stepped x 1.2 alone
+  // flat-joint calibration (default specimens, bond gap 1.0; the table in
+  // docs/calibration.md, "Fitting scheme"; the fit it gives: bench/README.md,
+  // "The joint step of the fit (flat joint)"), each stepped x 1.2 alone
   // from the result, converted from (ln sigma_b, ln c) to (ln sigma_b,
   // ln c/sigma_b): the sigma_b column is the sum of both (sigma_b and c
   // together x k), the ratio column the cohesion's. Scale invariance of a
