@@ -14,6 +14,7 @@
 #include "progress.h"
 #include "stages/breakage/breakage_matrix.h"
 #include "stages/breakage/campaign.h"
+#include "stages/breakage/circuit.h"
 #include "stages/breakage/impact_runs.h"
 #include "stages/breakage/in_mill_runs.h"
 #include "stages/breakage/mill_product.h"
@@ -83,8 +84,9 @@ void plan_sweep(const StageContext& ctx, const nlohmann::json& base, Plan& p) {
       }
 }
 
-// With a feed: the breakage matrix per rotor speed from the in-mill runs, or
-// a warning that says what the population balance needs.
+// With a feed: the breakage matrix per rotor speed from the in-mill runs and
+// the closed circuit's steady state, or a warning that says what the
+// population balance needs.
 void write_population_balance(StageContext& ctx, const std::vector<JobSpec>& in_mill) {
   const auto& d = ctx.cfg.doc;
   if (d.str("breakage.conditions") != "transport" || d.integer("breakage.in_mill.lumps") <= 0 ||
@@ -95,7 +97,7 @@ void write_population_balance(StageContext& ctx, const std::vector<JobSpec>& in_
         d.file()));
     return;
   }
-  write_breakage_matrices(ctx, in_mill);
+  write_circuit(ctx, write_breakage_matrices(ctx, in_mill));
 }
 
 }  // namespace
@@ -138,6 +140,8 @@ std::string BreakageStage::damaged_merged_outputs(const StageContext& ctx,
     if (ctx.cfg.feed && std::any_of(jobs.begin(), jobs.end(), is_in_mill_job)) {
       r.push_back(jobs::check_file(dir / "breakage_matrix.csv"));
       r.push_back(jobs::check_json(dir / "breakage_matrix.json", true));
+      r.push_back(jobs::check_file(dir / "circuit.csv"));
+      r.push_back(jobs::check_json(dir / "circuit.json", true));
     }
   }
   return jobs::first_problem(r);

@@ -1,7 +1,9 @@
 // A case with a feed end to end on the tiny mill: one 40-element lump per
 // rotor speed struck in the turning mill (stage 1's strike written by hand),
 // then the feed's population balance: the breakage matrix of the lump's
-// class measured from the run's pieces, the coarser feed class scaled.
+// class measured from the run's pieces, the coarser feed class scaled, and
+// the closed circuit's steady product per speed (circuit.json, circuit.csv)
+// in the report's headline.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -98,6 +100,63 @@ TEST_F(Feed, BreakageMatrixPerRotorSpeedFromTheInMillPieces) {
   }
   EXPECT_NE(slurp(stage() / "breakage_matrix.csv").find("rpm,from_class,from_upper_mm"),
             std::string::npos);
+}
+
+TEST_F(Feed, ClosedCircuitPerRotorSpeedWithProductP80LoadAndResidual) {
+  ASSERT_EQ(status_, 0) << slurp(*dir_ / "breakage.log");
+  const json c = read("circuit.json");
+  EXPECT_EQ(c.at("feed").at("rate_t_h").get<double>(), 20.0);
+  EXPECT_EQ(c.at("feed").at("cut_size_mm").get<double>(), 8.0);
+  ASSERT_EQ(c.at("rotor_speeds").size(), kRpm.size());
+  const json m = read("breakage_matrix.json");
+  for (size_t k = 0; k < kRpm.size(); ++k) {
+    const json& e = c.at("rotor_speeds")[k];
+    EXPECT_EQ(e.at("rpm").get<double>(), kRpm[k]);
+    ASSERT_TRUE(e.at("steady").get<bool>()) << e.dump(2);
+    // The product leaves through the 8 mm grate: nothing coarser in it, and
+    // it carries the whole feed at steady state.
+    const auto prod = e.at("product_t_h").get<std::vector<double>>();
+    ASSERT_EQ(prod.size(), 8u);
+    double total = 0;
+    for (size_t i = 0; i < prod.size(); ++i) {
+      total += prod[i];
+      if (i >= 4) {
+        EXPECT_EQ(prod[i], 0.0) << "above the cut: sieve index " << i;
+      }
+    }
+    EXPECT_NEAR(total, 20.0, 1e-9 * 20);
+    EXPECT_LE(e.at("mass_balance_residual").get<double>(), 1e-9);
+    EXPECT_NEAR(e.at("passing_percent").back().get<double>(), 100.0, 1e-9);
+    ASSERT_TRUE(e.at("p80_mm").is_number()) << e.dump(2);
+    EXPECT_LE(e.at("p80_mm").get<double>(), 8.0);
+    EXPECT_GE(e.at("p80_mm").get<double>(), e.at("p50_mm").get<double>());
+    // The circulating load: what the cut returned over the fresh feed.
+    const auto ret = e.at("returned_t_h").get<std::vector<double>>();
+    double returned = 0;
+    for (double r : ret) returned += r;
+    EXPECT_NEAR(e.at("circulating_load").get<double>(), returned / 20.0, 1e-12);
+    // The coarsest class (22.4-31.5 mm) gets only fresh feed, 8 t/h:
+    // m0 = f0 / (1 - b00) (c = 1), from the matrix of the same speed.
+    const double b00 = m.at("rotor_speeds")[k].at("matrix")[0][0].get<double>();
+    EXPECT_NEAR(e.at("mill_input_t_h")[7].get<double>(), 8.0 / (1.0 - b00), 1e-9);
+  }
+  EXPECT_NE(slurp(stage() / "circuit.csv")
+                .find("rpm,class,lower_mm,upper_mm,feed_t_h,mill_input_t_h,returned_t_h,"
+                      "product_t_h,product_passing_percent"),
+            std::string::npos);
+
+  // The report: a row per rotor speed with the closed circuit's P80.
+  ASSERT_EQ(
+      orchestrate("--case " + kData + "/tiny_feed.yaml --stage report --output " + dir_->string(),
+                  *dir_ / "report.log"),
+      0)
+      << slurp(*dir_ / "report.log");
+  const std::string html = slurp(*dir_ / "report/index.html");
+  EXPECT_NE(html.find("product P80, closed circuit, 2000 rpm"), std::string::npos);
+  const json summary = json::parse(slurp(*dir_ / "report/summary.json"));
+  const json h = summary.at("headline").at("circuit");
+  EXPECT_EQ(h.at("rpm2500").at("p80_mm"), c.at("rotor_speeds")[1].at("p80_mm"));
+  EXPECT_TRUE(h.at("rpm2000").contains("circulating_load"));
 }
 
 }  // namespace
