@@ -262,6 +262,13 @@ void circuit_json(const fs::path& run, Problems* problems, json& h) {
       if (e.contains(k)) x[k] = e.at(k);
     h["circuit"][fmt::format("rpm{:g}", d(e.at("rpm")))] = x;
   }
+  // With feed.target_p80_mm: the lowest rotor speed that meets it.
+  const json dec = pick(c, "decision");
+  if (dec.is_object())
+    h["circuit_decision"] = {{"target_p80_mm", pick(dec, "target_p80_mm")},
+                             {"kind", pick(dec, "kind")},
+                             {"rpm", pick(dec, "rpm")},
+                             {"sentence", pick(dec, "sentence")}};
 }
 
 // Appends rows under the titles of headline_groups().
@@ -523,6 +530,12 @@ void product_rows(const json& h, const RowAdder& add) {
 
 // The rows of the closed circuit with the feed, per rotor speed.
 void circuit_rows(const json& h, const RowAdder& add) {
+  const json dec = pick(h, "circuit_decision");
+  if (num(pick(dec, "target_p80_mm")) && pick(dec, "sentence").is_string())
+    add(5,
+        fmt::format("lowest rotor speed for a product P80 <= {} mm",
+                    g3(d(dec.at("target_p80_mm")))),
+        dec.at("sentence").get<std::string>());
   const json circ = pick(h, "circuit");
   for (const auto& rpm : rpm_keys(circ)) {
     const json& c = circ.at(rpm);

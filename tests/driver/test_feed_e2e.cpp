@@ -3,7 +3,8 @@
 // then the feed's population balance: the breakage matrix of the lump's
 // class measured from the run's pieces, the coarser feed class scaled, and
 // the closed circuit's steady product per speed (circuit.json, circuit.csv)
-// in the report's headline.
+// and the lowest speed that meets feed.target_p80_mm, in the report's
+// headline.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -157,6 +158,47 @@ TEST_F(Feed, ClosedCircuitPerRotorSpeedWithProductP80LoadAndResidual) {
   const json h = summary.at("headline").at("circuit");
   EXPECT_EQ(h.at("rpm2500").at("p80_mm"), c.at("rotor_speeds")[1].at("p80_mm"));
   EXPECT_TRUE(h.at("rpm2000").contains("circulating_load"));
+}
+
+TEST_F(Feed, DecisionOnTheTargetP80FromTheSimulatedSpeeds) {
+  ASSERT_EQ(status_, 0) << slurp(*dir_ / "breakage.log");
+  const json c = read("circuit.json");
+  const json& dec = c.at("decision");
+  EXPECT_EQ(dec.at("target_p80_mm").get<double>(), 6.0);
+  // The decision from the two speeds' P80 (both steady: checked above).
+  const double p0 = c.at("rotor_speeds")[0].at("p80_mm").get<double>();
+  const double p1 = c.at("rotor_speeds")[1].at("p80_mm").get<double>();
+  std::string want;
+  if (p0 <= 6.0) {
+    EXPECT_EQ(dec.at("kind"), "met_at_lowest");
+    want = p1 <= 6.0 ? "met at every simulated speed: lowest simulated 2000 rpm"
+                     : "met at the lowest simulated speed, 2000 rpm, but not at 2500 rpm";
+  } else if (p1 <= 6.0) {
+    EXPECT_EQ(dec.at("kind"), "crossed");
+    const double rpm = 2000 + (6.0 - p0) / (p1 - p0) * 500;
+    EXPECT_NEAR(dec.at("rpm").get<double>(), rpm, 1e-9);
+    want = fmt::format("met from {:.0f} rpm (interpolated between 2000 and 2500 rpm)", rpm);
+  } else {
+    EXPECT_EQ(dec.at("kind"), "not_met");
+    EXPECT_TRUE(dec.at("rpm").is_null());
+    want = "not met at any simulated speed";
+  }
+  EXPECT_EQ(dec.at("sentence").get<std::string>(), want);
+  EXPECT_TRUE(fs::exists(stage() / "plots/circuit_p80_vs_rpm.png"));
+
+  // The report's headline row and summary.json carry it.
+  if (!fs::exists(*dir_ / "report/index.html")) {
+    ASSERT_EQ(
+        orchestrate("--case " + kData + "/tiny_feed.yaml --stage report --output " + dir_->string(),
+                    *dir_ / "report.log"),
+        0)
+        << slurp(*dir_ / "report.log");
+  }
+  const std::string html = slurp(*dir_ / "report/index.html");
+  EXPECT_NE(html.find("lowest rotor speed for a product P80 &lt;= 6 mm"), std::string::npos);
+  EXPECT_NE(html.find(want), std::string::npos) << want;
+  const json summary = json::parse(slurp(*dir_ / "report/summary.json"));
+  EXPECT_EQ(summary.at("headline").at("circuit_decision").at("sentence"), want);
 }
 
 }  // namespace

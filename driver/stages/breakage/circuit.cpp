@@ -4,6 +4,9 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
+#include "engine/runner.h"
 #include "jobs/job_store.h"
 #include "postprocess/fragments.h"
 #include "progress.h"
@@ -16,6 +19,49 @@ namespace {
 // A vector given coarsest first, finest first (as the case's sieves).
 std::vector<double> ascending(const std::vector<double>& coarsest_first) {
   return {coarsest_first.rbegin(), coarsest_first.rend()};
+}
+
+// With feed.target_p80_mm: the lowest rotor speed whose closed-circuit P80
+// meets it (post::LowestSpeedMeetingP80) as circuit.json's "decision".
+nlohmann::json decision_json(const config::Feed& feed, const nlohmann::json& speeds) {
+  std::vector<post::SpeedForP80> points;
+  for (const auto& e : speeds) {
+    double p80 = HUGE_VAL;  // no steady state: never meets the target
+    if (e.at("steady").get<bool>())
+      p80 = e.at("p80_mm").is_number() ? e.at("p80_mm").get<double>() : feed.sizes_mm.front();
+    points.push_back({e.at("rpm").get<double>(), p80});
+  }
+  const post::TargetDecision d = post::LowestSpeedMeetingP80(points, *feed.target_p80_mm);
+  using K = post::TargetDecision::Kind;
+  const char* kind = d.kind == K::crossed         ? "crossed"
+                     : d.kind == K::met_at_lowest ? "met_at_lowest"
+                                                  : "not_met";
+  nlohmann::json j = {
+      {"target_p80_mm", *feed.target_p80_mm},
+      {"kind", kind},
+      {"rpm", d.kind == K::not_met ? nlohmann::json(nullptr) : nlohmann::json(d.rpm)},
+      {"met_at_every_faster_speed", d.met_above},
+      {"sentence", post::DecisionSentence(d)},
+      {"definition",
+       "the lowest rotor speed whose closed-circuit product P80 is at or below "
+       "the target, interpolated linearly in rpm between the two simulated "
+       "speeds where P80 crosses it; a P80 finer than the finest sieve counts as "
+       "that sieve, a speed with no steady state as not met"}};
+  if (d.kind == K::crossed) {
+    j["between_rpm"] = {d.below_rpm, d.above_rpm};
+    j["interpolated"] = d.interpolated;
+  }
+  return j;
+}
+
+// P80 against rpm with the target and the decision
+// (postprocess/plot_circuit.py, reading circuit.json only).
+void plot_circuit(StageContext& ctx) {
+  const std::filesystem::path dir = ctx.stage_dir;
+  engine::run_python(
+      ctx.runner, ctx.cfg.project_dir / "postprocess" / "plot_circuit.py",
+      {"--circuit", (dir / "circuit.json").string(), "--out", (dir / "plots").string()},
+      dir / "plot_circuit.log", "breakage/circuit plot");
 }
 
 std::string mm_or_finer(const nlohmann::json& v, double finest) {
@@ -82,7 +128,7 @@ void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatr
         mm_or_finer(e["p50_mm"], feed.sizes_mm.front()), s.circulating_load,
         s.mass_balance_residual));
   }
-  const nlohmann::json j = {
+  nlohmann::json j = {
       {"feed",
        {{"sizes_mm", feed.sizes_mm},
         {"mass_fractions", feed.mass_fractions},
@@ -105,8 +151,15 @@ void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatr
          "m = f + C B m, product P = (I - C) B m (Whiten 1974; Austin, Klimpel & Luckie 1984); B "
          "from breakage/breakage_matrix.json, C the sharp cut at feed.cut_size_mm"},
         {"steady", "false when a class above the cut never breaks: no steady state (problem)"}}}};
+  if (feed.target_p80_mm && !speeds.empty()) {
+    j["decision"] = decision_json(feed, speeds);
+    ctx.progress.info(fmt::format("[breakage] product P80 <= {:g} mm in the closed circuit: {}",
+                                  *feed.target_p80_mm,
+                                  j["decision"]["sentence"].get<std::string>()));
+  }
   jobs::atomic_write(ctx.stage_dir / "circuit.json", j.dump(2) + "\n");
   jobs::atomic_write(ctx.stage_dir / "circuit.csv", csv);
+  plot_circuit(ctx);
 }
 
 }  // namespace mill::breakage
