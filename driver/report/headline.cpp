@@ -260,6 +260,8 @@ void circuit_json(const fs::path& run, Problems* problems, json& h) {
     for (const char* k : {"p50_mm", "p80_mm", "circulating_load", "mass_balance_residual",
                           "product_total_t_h", "problem"})
       if (e.contains(k)) x[k] = e.at(k);
+    for (const char* k : {"specific_energy_kWh_t", "ore_power_W", "gas_shaft_power_W"})
+      if (pick(e, "energy").is_object()) x[k] = pick(e.at("energy"), k);
     h["circuit"][fmt::format("rpm{:g}", d(e.at("rpm")))] = x;
   }
   // With feed.target_p80_mm: the lowest rotor speed that meets it.
@@ -540,6 +542,13 @@ void circuit_rows(const json& h, const RowAdder& add) {
   for (const auto& rpm : rpm_keys(circ)) {
     const json& c = circ.at(rpm);
     const std::string at = ", " + rpm_words(rpm);
+    if (num(pick(c, "specific_energy_kWh_t")) && num(pick(c, "ore_power_W")))
+      add(5, "energy per tonne of feed" + at,
+          fmt::format("{} kWh/t ({}ore {} kW)", g3(d(c.at("specific_energy_kWh_t"))),
+                      num(pick(c, "gas_shaft_power_W"))
+                          ? "gas shaft " + g3(d(c.at("gas_shaft_power_W")) / 1000) + " kW + "
+                          : std::string("no gas flow run: "),
+                      g3(d(c.at("ore_power_W")) / 1000)));
     if (pick(c, "steady").is_boolean() && !c.at("steady").get<bool>()) {
       add(5, "closed circuit" + at,
           "no steady state: " + (pick(c, "problem").is_string() ? c.at("problem").get<std::string>()

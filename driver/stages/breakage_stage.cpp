@@ -97,7 +97,7 @@ void write_population_balance(StageContext& ctx, const std::vector<JobSpec>& in_
         d.file()));
     return;
   }
-  write_circuit(ctx, write_breakage_matrices(ctx, in_mill));
+  write_circuit(ctx, write_breakage_matrices(ctx, in_mill), read_mill_energy(ctx, in_mill));
 }
 
 }  // namespace

@@ -42,9 +42,16 @@ class Feed : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = new fs::path(scratch("feed"));
     write_transport_impacts(*dir_);
+    // A scripted flow report at 2000 rpm: the gas takes 30 kW at the shaft.
+    fs::create_directories(*dir_ / "flow/rpm2000");
+    spit(*dir_ / "flow/rpm2000/flow_report.json",
+         R"({"shaft": {"torque_Nm": 143.2, "power_W": 30000.0}})");
     status_ = orchestrate(
         "--case " + kData + "/tiny_feed.yaml --stage breakage --output " + dir_->string(),
         *dir_ / "breakage.log");
+    // The report would draw the flow's geometry and convergence from files
+    // this scripted flow lacks.
+    fs::remove_all(*dir_ / "flow");
   }
   static void TearDownTestSuite() { delete dir_; }
   static fs::path* dir_;
@@ -199,6 +206,33 @@ TEST_F(Feed, DecisionOnTheTargetP80FromTheSimulatedSpeeds) {
   EXPECT_NE(html.find(want), std::string::npos) << want;
   const json summary = json::parse(slurp(*dir_ / "report/summary.json"));
   EXPECT_EQ(summary.at("headline").at("circuit_decision").at("sentence"), want);
+}
+
+TEST_F(Feed, EnergyPerTonneAgainstItsClosedForm) {
+  ASSERT_EQ(status_, 0) << slurp(*dir_ / "breakage.log");
+  const json c = read("circuit.json");
+  for (const auto& e : c.at("rotor_speeds")) {
+    const double rpm = e.at("rpm").get<double>();
+    const json run =
+        json::parse(slurp(stage() / fmt::format("jobs/rpm{:g}_mill_p1/in_mill.json", rpm)));
+    const double w = run.at("energy").at("work_beater_J").get<double>() /
+                     run.at("element_mass_kg").get<double>();  // J per kg
+    ASSERT_GT(w, 0.0) << run.dump(2);
+    // kWh/t = (P_gas [kW] + w [J/kg] x 20 t/h x 1000 / 3600 / 1000) / 20 t/h
+    //       = P_gas / 20 + w / 3600; the scripted gas power only at 2000 rpm.
+    const double gas_kW = rpm == 2000 ? 30.0 : 0.0;
+    const json& en = e.at("energy");
+    EXPECT_NEAR(en.at("specific_energy_kWh_t").get<double>(), gas_kW / 20 + w / 3600,
+                1e-12 * (gas_kW / 20 + w / 3600))
+        << en.dump(2);
+    EXPECT_NEAR(en.at("ore_power_W").get<double>(), w * 20000.0 / 3600, 1e-9 * w);
+    EXPECT_EQ(en.at("gas_shaft_power_W").is_null(), rpm != 2000) << en.dump(2);
+  }
+  const json summary = json::parse(slurp(*dir_ / "report/summary.json"));
+  EXPECT_TRUE(
+      summary.at("headline").at("circuit").at("rpm2000").at("specific_energy_kWh_t").is_number());
+  EXPECT_NE(slurp(*dir_ / "report/index.html").find("energy per tonne of feed, 2000 rpm"),
+            std::string::npos);
 }
 
 }  // namespace

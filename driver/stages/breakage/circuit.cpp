@@ -71,7 +71,8 @@ std::string mm_or_finer(const nlohmann::json& v, double finest) {
 
 }  // namespace
 
-void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatrix>& matrices) {
+void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatrix>& matrices,
+                   const std::map<double, MillEnergy>& energy) {
   const config::Feed& feed = ctx.cfg.feed.value();
   const post::SizeClasses classes = post::SizeClassesFromSieves(feed.sizes_mm);
   const std::size_t n = classes.size();
@@ -84,6 +85,16 @@ void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatr
       "product_passing_percent,classification_returned\n";
   for (const auto& [rpm, m] : matrices) {
     nlohmann::json e = {{"rpm", rpm}};
+    if (auto it = energy.find(rpm); it != energy.end()) {
+      e["energy"] = energy_json(it->second, feed.rate_tph);
+      ctx.progress.info(fmt::format(
+          "[breakage] energy at {:g} rpm: {:.3g} kWh/t ({}ore {:.3g} kW at {:g} t/h)", rpm,
+          e["energy"]["specific_energy_kWh_t"].get<double>(),
+          it->second.has_gas
+              ? fmt::format("gas shaft {:.3g} kW + ", it->second.gas_shaft_power_W / 1000)
+              : std::string("no flow report: "),
+          e["energy"]["ore_power_W"].get<double>() / 1000, feed.rate_tph));
+    }
     post::CircuitState s;
     try {
       s = post::SolveCircuit(classes, m.b, c, f);
@@ -144,7 +155,9 @@ void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatr
         {"*_mm", "mm"},
         {"passing_percent", "% of the product's mass passing each sieve of sieves_mm"},
         {"circulating_load", "t returned to the rotor per t of fresh feed"},
-        {"mass_balance_residual", "|product - feed| / feed, 1"}}},
+        {"mass_balance_residual", "|product - feed| / feed, 1"},
+        {"energy.*_kWh_t", "kWh per t of fresh feed"},
+        {"energy.*_W", "W"}}},
       {"definitions",
        {{"order", "every per-class list follows sieves_mm, finest first"},
         {"steady_state",

@@ -9,6 +9,7 @@
 #include <map>
 
 #include "postprocess/breakage_matrix.h"
+#include "stages/breakage/mill_energy.h"
 #include "stages/stage.h"
 
 namespace mill::breakage {
@@ -17,9 +18,11 @@ namespace mill::breakage {
 // fails naming the rotor speed.
 inline constexpr double kCircuitResidualLimit = 1e-9;
 
-// breakage/circuit.json and circuit.csv from the matrices per rotor speed.
+// breakage/circuit.json and circuit.csv from the matrices per rotor speed,
+// with each speed's energy per tonne (mill_energy.h) where `energy` has it.
 // A speed at which a class above the cut never breaks has no steady state:
 // its entry says why (steady: false) and the others go on.
-void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatrix>& matrices);
+void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatrix>& matrices,
+                   const std::map<double, MillEnergy>& energy);
 
 }  // namespace mill::breakage
