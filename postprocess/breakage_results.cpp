@@ -565,6 +565,29 @@ void WriteBreakageH5(const std::string& path, const std::vector<ImpactResult>& r
   });
 }
 
+// The one impact's pieces of impact.h5.
+ImpactPieces ReadImpactPieces(const std::string& path) {
+  const h5::Quiet quiet;
+  const h5::Handle in = h5::OpenFile(path, H5F_ACC_RDONLY);
+  if (H5Lexists(in, "impacts", H5P_DEFAULT) <= 0)
+    throw PostError(fmt::format("{}: no /impacts group (not an impact.h5?)", path));
+  const h5::Handle impacts(H5Gopen2(in, "impacts", H5P_DEFAULT), H5Gclose, in,
+                           "open group 'impacts'");
+  const std::vector<std::string> names = LinkNames(impacts);
+  if (names.size() != 1)
+    throw PostError(fmt::format("{}: {} impacts under /impacts; expected the one of its run", path,
+                                names.size()));
+  const h5::Handle g(H5Gopen2(impacts, names[0].c_str(), H5P_DEFAULT), H5Gclose, impacts,
+                     fmt::format("open group '{}'", names[0]));
+  ImpactPieces p{h5::ReadDoubles(g, "d_rel"), h5::ReadDoubles(g, "mass")};
+  if (p.d_rel.size() != p.mass_kg.size() || p.mass_kg.empty())
+    throw PostError(
+        fmt::format("{}:/impacts/{}: {} sizes and {} masses; expected as many, at "
+                    "least one",
+                    path, names[0], p.d_rel.size(), p.mass_kg.size()));
+  return p;
+}
+
 // breakage.h5 merged from per-impact files.
 void MergeBreakageH5Files(const std::string& path, const std::vector<std::string>& inputs) {
   h5::WriteFileAtomically(path, path + ".tmp", [&](hid_t out) {

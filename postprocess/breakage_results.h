@@ -142,6 +142,15 @@ void WriteBreakageH5(const std::string& path, const std::vector<ImpactResult>& r
 // they existed: NaN, or the field's default). Writes path.tmp, then renames.
 void MergeBreakageH5Files(const std::string& path, const std::vector<std::string>& inputs);
 
+// The pieces of the one impact in a file of one impact (impact.h5): their
+// relative size d/D and mass (kg), heaviest first. Throws PostError naming
+// the file unless it holds exactly one impact with as many sizes as masses.
+struct ImpactPieces {
+  std::vector<double> d_rel;
+  std::vector<double> mass_kg;
+};
+ImpactPieces ReadImpactPieces(const std::string& path);
+
 // Adds the group /energy to an existing file of one impact (impact.h5): one
 // dataset per ledger column, each with its `unit` attribute (LedgerUnit), and
 // the attribute `balance`. Replaces /energy if present.

@@ -148,4 +148,19 @@ void WriteDataset(hid_t loc, const std::string& name, const std::vector<long lon
                unit);
 }
 
+// A dataset's values as doubles.
+std::vector<double> ReadDoubles(hid_t loc, const std::string& name) {
+  const Quiet quiet;
+  const std::string op = fmt::format("read dataset '{}'", name);
+  if (H5Lexists(loc, name.c_str(), H5P_DEFAULT) <= 0) Fail(Where(loc), op + " (missing)");
+  Handle set(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), H5Dclose, loc, op);
+  Handle space(H5Dget_space(set), H5Sclose, loc, op);
+  const hssize_t n = H5Sget_simple_extent_npoints(space);
+  if (n < 0) Fail(Where(set), op);
+  std::vector<double> v(static_cast<std::size_t>(n));
+  if (n > 0)
+    Check(H5Dread(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), set, op);
+  return v;
+}
+
 }  // namespace mill::post::h5

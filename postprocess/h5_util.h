@@ -95,4 +95,8 @@ void WriteDataset(hid_t loc, const std::string& name, const std::vector<double>&
 void WriteDataset(hid_t loc, const std::string& name, const std::vector<long long>& v,
                   const std::vector<hsize_t>& dims, const std::string& unit);
 
+// Every value of the dataset `name` in loc as doubles (any shape, row-major);
+// throws naming the place when it is missing or cannot be read.
+std::vector<double> ReadDoubles(hid_t loc, const std::string& name);
+
 }  // namespace mill::post::h5

@@ -299,4 +299,57 @@ std::optional<double> SizeAtPercentPassing(const SizeClasses& classes,
   return SizeAtPercentPassing(sieves, CumulativePassingPercent(fraction), percent);
 }
 
+TargetDecision LowestSpeedMeetingP80(std::vector<SpeedForP80> points, double target_mm) {
+  if (points.empty()) throw PostError("P80 against rotor speed: no rotor speed");
+  if (!std::isfinite(target_mm) || !(target_mm > 0.0))
+    throw PostError(fmt::format("P80 target: {}; expected a size > 0 mm", target_mm));
+  std::sort(points.begin(), points.end(),
+            [](const SpeedForP80& a, const SpeedForP80& b) { return a.rpm < b.rpm; });
+  for (std::size_t k = 1; k < points.size(); ++k)
+    if (points[k].rpm == points[k - 1].rpm)
+      throw PostError(fmt::format("P80 against rotor speed: {:g} rpm given twice", points[k].rpm));
+  const auto met = [&](const SpeedForP80& p) { return p.p80_mm <= target_mm; };
+  TargetDecision d;
+  std::size_t k = 0;
+  while (k < points.size() && !met(points[k])) ++k;
+  if (k == points.size()) return d;  // not_met
+  if (k == 0) {
+    d.kind = TargetDecision::Kind::met_at_lowest;
+    d.rpm = points[0].rpm;
+  } else {
+    const SpeedForP80 &lo = points[k - 1], &hi = points[k];
+    d.kind = TargetDecision::Kind::crossed;
+    d.below_rpm = lo.rpm;
+    d.above_rpm = hi.rpm;
+    d.interpolated = std::isfinite(lo.p80_mm);
+    d.rpm = d.interpolated
+                ? lo.rpm + (target_mm - lo.p80_mm) / (hi.p80_mm - lo.p80_mm) * (hi.rpm - lo.rpm)
+                : hi.rpm;
+  }
+  for (std::size_t i = k + 1; i < points.size(); ++i)
+    if (!met(points[i])) {
+      d.met_above = false;
+      d.first_unmet_above = points[i].rpm;
+      break;
+    }
+  return d;
+}
+
+std::string DecisionSentence(const TargetDecision& d) {
+  using K = TargetDecision::Kind;
+  if (d.kind == K::not_met) return "not met at any simulated speed";
+  std::string s;
+  if (d.kind == K::met_at_lowest)
+    s = d.met_above ? fmt::format("met at every simulated speed: lowest simulated {:g} rpm", d.rpm)
+                    : fmt::format("met at the lowest simulated speed, {:g} rpm", d.rpm);
+  else if (d.interpolated)
+    s = fmt::format("met from {:.0f} rpm (interpolated between {:g} and {:g} rpm)", d.rpm,
+                    d.below_rpm, d.above_rpm);
+  else
+    s = fmt::format("met from {:g} rpm (no steady state at {:g} rpm to interpolate from)", d.rpm,
+                    d.below_rpm);
+  if (!d.met_above) s += fmt::format(", but not at {:g} rpm", d.first_unmet_above);
+  return s;
+}
+
 }  // namespace mill::post

@@ -137,4 +137,38 @@ PassHistory IterateCircuit(const SizeClasses& classes, const BreakageMatrix& b,
 std::optional<double> SizeAtPercentPassing(const SizeClasses& classes,
                                            const std::vector<double>& mass, double percent);
 
+// The lowest rotor speed at which the product's P80 meets a target (P80 at
+// or below it), from the P80 at each simulated speed.
+struct SpeedForP80 {
+  double rpm = 0;     // a speed: simulated or interpolated
+  double p80_mm = 0;  // P80 (mm); +inf: no steady state at that speed
+};
+struct TargetDecision {
+  // crossed: P80 crosses the target between two simulated speeds, `rpm`
+  // interpolated linearly in rpm between them (or the faster of them when
+  // the slower has no steady state: nothing to interpolate from);
+  // met_at_lowest: met already at the lowest simulated speed, `rpm` (no
+  // crossing below it); not_met: met at no simulated speed.
+  enum class Kind { crossed, met_at_lowest, not_met } kind = Kind::not_met;
+  double rpm = 0;
+  double below_rpm = 0;          // crossed: the slower speed of the pair
+  double above_rpm = 0;          // crossed: the faster speed of the pair
+  bool interpolated = false;     // crossed: between two P80s (else the faster speed)
+  bool met_above = true;         // met at every simulated speed above `rpm` too
+  double first_unmet_above = 0;  // when not met_above: the slowest such speed
+};
+
+// Walks up in rotor speed (the points are sorted here; at least one, speeds
+// distinct) to the first speed whose P80 is at or below target_mm and
+// interpolates between it and the speed before: rpm = r0 + (target - p0) /
+// (p1 - p0) (r1 - r0). A P80 finer than the finest sieve is passed as that
+// sieve (an upper bound, which meets any target at or above it). Throws
+// PostError on no point, a repeated speed or a target that is not > 0.
+TargetDecision LowestSpeedMeetingP80(std::vector<SpeedForP80> points, double target_mm);
+
+// The decision in one sentence, e.g. "met from 2240 rpm (interpolated
+// between 2000 and 2500 rpm)", "met at every simulated speed: lowest
+// simulated 2000 rpm", "not met at any simulated speed".
+std::string DecisionSentence(const TargetDecision& d);
+
 }  // namespace mill::post

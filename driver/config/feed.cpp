@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "config/case_config.h"
+#include "postprocess/breakage_matrix.h"
 #include "postprocess/population_balance.h"
 
 namespace mill::config {
@@ -149,7 +150,27 @@ std::optional<Feed> read_feed(const Document& d) {
   f.cut_size_mm = d.real(kCut);
   if (d.has(kTarget)) f.target_p80_mm = d.real(kTarget);
   check_cut_and_target(d, f);
+  if (d.integer("breakage.in_mill.lumps") > 0) lump_feed_class(d, f);
   return f;
+}
+
+std::size_t lump_feed_class(const Document& d, const Feed& f) {
+  const post::SizeClasses c = post::SizeClassesFromSieves(f.sizes_mm);
+  const double lump_mm = 1000 * d.real("lump.diameter");
+  const std::size_t j = post::ClassOfSize(c, lump_mm);
+  if (j == c.size())
+    fail(d, "lump.diameter",
+         fmt::format("{:g} mm is at or above the top sieve of feed.sizes_mm ({:g} mm); the in-mill "
+                     "lumps (breakage.in_mill.lumps) measure the breakage of their feed class: add "
+                     "a coarser sieve to feed.sizes_mm, or make the lump smaller",
+                     lump_mm, c.upper_mm.front()));
+  if (j + 1 == c.size())
+    fail(d, "lump.diameter",
+         fmt::format("{:g} mm lies in the finest class of feed.sizes_mm (below {:g} mm), whose "
+                     "breakage no sieve sees; expected a lump of a coarser feed class: make the "
+                     "lump larger, or add finer sieves to feed.sizes_mm",
+                     lump_mm, c.upper_mm.back()));
+  return j;
 }
 
 }  // namespace mill::config

@@ -6,6 +6,7 @@
 // the target against the sieves) are checked here, when the case is loaded.
 #pragma once
 
+#include <cstddef>
 #include <optional>
 #include <vector>
 
@@ -32,5 +33,13 @@ inline constexpr double kFeedTopTail = 0.01;
 // as without a feed). Throws ConfigError naming the file, line and key, the
 // value found and what is expected.
 std::optional<Feed> read_feed(const Document& d);
+
+// The class of feed.sizes_mm (coarsest first, as the population balance
+// numbers them) that the in-mill lumps (lump.diameter) belong to: their runs
+// make its column of the breakage matrix. Throws ConfigError naming
+// lump.diameter when the lump lies at or above the top sieve or in the
+// finest class (no sieve would see its breakage). Checked by read_feed when
+// breakage.in_mill.lumps > 0.
+std::size_t lump_feed_class(const Document& d, const Feed& f);
 
 }  // namespace mill::config

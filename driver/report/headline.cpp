@@ -260,6 +260,35 @@ void product_json(const fs::path& run, Problems* problems, json& h) {
       }
 }
 
+// headline.json's "circuit": with a feed, per rotor speed the closed
+// circuit's steady product (breakage/circuit.json).
+void circuit_json(const fs::path& run, Problems* problems, json& h) {
+  const fs::path f = run / "breakage" / "circuit.json";
+  if (!fs::exists(f)) return;
+  const auto c = read_json(f, problems);
+  if (!c.is_object() || !pick(c, "rotor_speeds").is_array()) return;
+  const json sieves = pick(c, "sieves_mm");
+  for (const auto& e : c.at("rotor_speeds")) {
+    if (!num(pick(e, "rpm"))) continue;
+    json x = {
+        {"steady", pick(e, "steady")},
+        {"finest_sieve_mm", sieves.is_array() && !sieves.empty() ? sieves[0] : json(nullptr)}};
+    for (const char* k : {"p50_mm", "p80_mm", "circulating_load", "mass_balance_residual",
+                          "product_total_t_h", "problem"})
+      if (e.contains(k)) x[k] = e.at(k);
+    for (const char* k : {"specific_energy_kWh_t", "ore_power_W", "gas_shaft_power_W"})
+      if (pick(e, "energy").is_object()) x[k] = pick(e.at("energy"), k);
+    h["circuit"][fmt::format("rpm{:g}", d(e.at("rpm")))] = x;
+  }
+  // With feed.target_p80_mm: the lowest rotor speed that meets it.
+  const json dec = pick(c, "decision");
+  if (dec.is_object())
+    h["circuit_decision"] = {{"target_p80_mm", pick(dec, "target_p80_mm")},
+                             {"kind", pick(dec, "kind")},
+                             {"rpm", pick(dec, "rpm")},
+                             {"sentence", pick(dec, "sentence")}};
+}
+
 // Appends rows under the titles of headline_groups().
 struct RowAdder {
   std::vector<HeadlineRow>& rows;
@@ -539,6 +568,47 @@ void product_rows(const json& h, const RowAdder& add) {
   }
 }
 
+// The rows of the closed circuit with the feed, per rotor speed.
+void circuit_rows(const json& h, const RowAdder& add) {
+  const json dec = pick(h, "circuit_decision");
+  if (num(pick(dec, "target_p80_mm")) && pick(dec, "sentence").is_string())
+    add(5,
+        fmt::format("lowest rotor speed for a product P80 <= {} mm",
+                    g3(d(dec.at("target_p80_mm")))),
+        dec.at("sentence").get<std::string>());
+  const json circ = pick(h, "circuit");
+  for (const auto& rpm : rpm_keys(circ)) {
+    const json& c = circ.at(rpm);
+    const std::string at = ", " + rpm_words(rpm);
+    if (num(pick(c, "specific_energy_kWh_t")) && num(pick(c, "ore_power_W")))
+      add(5, "energy per tonne of feed" + at,
+          fmt::format("{} kWh/t ({}ore {} kW)", g3(d(c.at("specific_energy_kWh_t"))),
+                      num(pick(c, "gas_shaft_power_W"))
+                          ? "gas shaft " + g3(d(c.at("gas_shaft_power_W")) / 1000) + " kW + "
+                          : std::string("no gas flow run: "),
+                      g3(d(c.at("ore_power_W")) / 1000)));
+    if (pick(c, "steady").is_boolean() && !c.at("steady").get<bool>()) {
+      add(5, "closed circuit" + at,
+          "no steady state: " + (pick(c, "problem").is_string() ? c.at("problem").get<std::string>()
+                                                                : std::string("?")));
+      continue;
+    }
+    auto size = [&](const char* k) {
+      if (num(pick(c, k))) return g3(d(c[k])) + " mm";
+      if (num(pick(c, "finest_sieve_mm"))) return "< " + g3(d(c.at("finest_sieve_mm"))) + " mm";
+      return std::string("?");
+    };
+    add(5, "product P80, closed circuit" + at, size("p80_mm") + " (P50 " + size("p50_mm") + ")");
+    if (num(pick(c, "circulating_load")))
+      add(5, "circulating load" + at,
+          fmt::format(
+              "{} t per t of fresh feed (mass balance closes to {:.1g})",
+              g3(d(c.at("circulating_load"))),
+              num(pick(c, "mass_balance_residual")) ? d(c.at("mass_balance_residual")) : NAN),
+          false);
+  }
+}
+
 }  // namespace
 
 const std::vector<HeadlineGroup>& headline_groups() {
@@ -547,7 +617,8 @@ const std::vector<HeadlineGroup>& headline_groups() {
       {"transport", "Ore lumps through the mill (stage 1b)"},
       {"calibrate", "Calibration of the bond model"},
       {"breakage", "Breakage of one lump (stage 2)"},
-      {"breakage", "Mill product, one pass (stages 1 and 2)"}};
+      {"breakage", "Mill product, one pass (stages 1 and 2)"},
+      {"breakage", "Mill product, closed circuit with the feed"}};
   return g;
 }
 
@@ -558,6 +629,7 @@ json headline_json(const fs::path& run, Problems* problems) {
   calibration_json(run, problems, h);
   breakage_json(run, problems, h);
   product_json(run, problems, h);
+  circuit_json(run, problems, h);
   return h;
 }
 
@@ -569,6 +641,7 @@ std::vector<HeadlineRow> headline_rows(const json& h) {
   calibration_rows(h, add);
   breakage_rows(h, add);
   product_rows(h, add);
+  circuit_rows(h, add);
   return rows;
 }
 

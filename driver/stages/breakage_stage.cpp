@@ -13,7 +13,9 @@
 #include "postprocess/impact_conditions.h"
 #include "progress.h"
 #include "stages/breakage/calibration_sets.h"
+#include "stages/breakage/breakage_matrix.h"
 #include "stages/breakage/campaign.h"
+#include "stages/breakage/circuit.h"
 #include "stages/breakage/impact_runs.h"
 #include "stages/breakage/in_mill_runs.h"
 #include "stages/breakage/mill_product.h"
@@ -83,6 +85,22 @@ void plan_sweep(const StageContext& ctx, const nlohmann::json& base, Plan& p) {
       }
 }
 
+// With a feed: the breakage matrix per rotor speed from the in-mill runs and
+// the closed circuit's steady state, or a warning that says what the
+// population balance needs.
+void write_population_balance(StageContext& ctx, const std::vector<JobSpec>& in_mill) {
+  const auto& d = ctx.cfg.doc;
+  if (d.str("breakage.conditions") != "transport" || d.integer("breakage.in_mill.lumps") <= 0 ||
+      in_mill.empty()) {
+    ctx.progress.warn(fmt::format(
+        "{}: the feed's population balance needs in-mill runs (breakage.conditions: transport "
+        "and breakage.in_mill.lumps >= 1); none ran, so there is no breakage matrix",
+        d.file()));
+    return;
+  }
+  write_circuit(ctx, write_breakage_matrices(ctx, in_mill), read_mill_energy(ctx, in_mill));
+}
+
 }  // namespace
 
 std::string BreakageStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
@@ -127,6 +145,12 @@ std::string BreakageStage::damaged_merged_outputs(const StageContext& ctx,
   if (ctx.cfg.doc.str("breakage.conditions") == "transport") {
     r.push_back(jobs::check_file(dir / "product.csv"));
     r.push_back(jobs::check_json(dir / "product.json", true));
+    if (ctx.cfg.feed && std::any_of(jobs.begin(), jobs.end(), is_in_mill_job)) {
+      r.push_back(jobs::check_file(dir / "breakage_matrix.csv"));
+      r.push_back(jobs::check_json(dir / "breakage_matrix.json", true));
+      r.push_back(jobs::check_file(dir / "circuit.csv"));
+      r.push_back(jobs::check_json(dir / "circuit.json", true));
+    }
   }
   return jobs::first_problem(r);
 }
@@ -191,6 +215,7 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& all_
   write_jk_fit(ctx, c.rows, from_transport);
   plot_campaign(ctx, c, from_transport);
   if (from_transport) write_mill_product(ctx, jobs, write_in_mill_results(ctx, in_mill));
+  if (ctx.cfg.feed) write_population_balance(ctx, in_mill);
   ctx.progress.info(fmt::format(
       "[breakage] results: {}/summary.csv, fractions.csv, size_distributions.csv, jk_fit.json, "
       "comminution_efficiency.json, breakage.h5, plots/*.png",

@@ -58,7 +58,8 @@ std::vector<fs::path> report_inputs(const fs::path& run) {
 int figure_rank(const fs::path& f) {
   static const std::vector<std::string> first = {
       "jk_t10_vs_ecs.png",        "passing_vs_size.png",
-      "product_vs_rpm.png",       "largest_vs_velocity.png",
+      "product_vs_rpm.png",       "circuit_p80_vs_rpm.png",
+      "largest_vs_velocity.png",
       "pieces_vs_velocity.png",   "comminution_efficiency_vs_velocity.png",
       "energy_ledger_fastest.png"};
   const auto it = std::find(first.begin(), first.end(), f.filename().string());

@@ -3,11 +3,15 @@
 // the program, reading files and job states, the tiny housing's gas field.
 #pragma once
 
+#include <fmt/format.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -112,6 +116,32 @@ inline post::FlowField tiny_housing_field(double rpm, const std::string& source)
   f.gas_model = "incompressible";
   f.source = source;
   return f;
+}
+
+// The header of a transport stage's impacts.csv.
+inline const char* kImpactsCsvHeader =
+    "time_s,particle_id,surface,x_m,y_m,z_m,contact_x_m,contact_y_m,contact_z_m,normal_x,normal_y,"
+    "normal_z,vrel_x_m_s,vrel_y_m_s,vrel_z_m_s,speed_m_s,normal_speed_m_s,tangential_speed_m_s,"
+    "angle_deg,surface_speed_m_s,particle_speed_m_s,axis_distance_m\n";
+
+// One impacts.csv row of a flywheel strike in the tiny mill (axis at (0,
+// 0.45) m) turning at `rpm`: lump `id` at `x`, lab velocity `v`, contact
+// point `c` on the flywheel, normal `n`; the relative velocity, speeds and
+// angle follow from them.
+inline std::string tiny_strike_row(double rpm, int id, double t, std::array<double, 3> x,
+                                   std::array<double, 3> v, std::array<double, 3> c,
+                                   std::array<double, 3> n) {
+  const double pi = 3.14159265358979323846;
+  const double w = rpm * 2 * pi / 60;
+  const double rx = c[0], ry = c[1] - 0.45;
+  const std::array<double, 3> vr = {v[0] + w * ry, v[1] - w * rx, v[2]};
+  const double speed = std::hypot(vr[0], vr[1], vr[2]);
+  const double vn = std::max(0.6, -(vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2]));
+  const double vt = std::sqrt(std::max(0.0, speed * speed - vn * vn));
+  return fmt::format("{},{},flywheel,{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", t,
+                     id, x[0], x[1], x[2], c[0], c[1], c[2], n[0], n[1], n[2], vr[0], vr[1], vr[2],
+                     speed, vn, vt, std::asin(std::min(1.0, vn / speed)) * 180 / pi,
+                     w * std::hypot(rx, ry), std::hypot(v[0], v[1], v[2]), std::hypot(rx, ry));
 }
 
 // State of job `label` of the stage whose folder is `stage_dir`.

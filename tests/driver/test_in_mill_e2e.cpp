@@ -32,20 +32,10 @@ using mill::jobs::State;
 const std::string kData = MILL_TEST_DATA;
 constexpr double kPi = 3.14159265358979323846;
 
-// One impacts.csv row: lump `id` at `x`, lab velocity `v`, contact point `c`
-// on the flywheel (axis at (0, 0.45), 2000 rpm), normal `n`.
+// One impacts.csv row of the tiny mill at 2000 rpm (tiny_strike_row).
 std::string row(int id, double t, std::array<double, 3> x, std::array<double, 3> v,
                 std::array<double, 3> c, std::array<double, 3> n) {
-  const double w = 2000 * 2 * kPi / 60;
-  const double rx = c[0], ry = c[1] - 0.45;
-  const std::array<double, 3> vr = {v[0] + w * ry, v[1] - w * rx, v[2]};
-  const double speed = std::hypot(vr[0], vr[1], vr[2]);
-  const double vn = std::max(0.6, -(vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2]));
-  const double vt = std::sqrt(std::max(0.0, speed * speed - vn * vn));
-  return fmt::format("{},{},flywheel,{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", t,
-                     id, x[0], x[1], x[2], c[0], c[1], c[2], n[0], n[1], n[2], vr[0], vr[1], vr[2],
-                     speed, vn, vt, std::asin(std::min(1.0, vn / speed)) * 180 / kPi,
-                     w * std::hypot(rx, ry), std::hypot(v[0], v[1], v[2]), std::hypot(rx, ry));
+  return tiny_strike_row(2000, id, t, x, v, c, n);
 }
 
 // Lump 1: falling at 5 m/s onto plate 0's leading face, which points up at
@@ -55,11 +45,7 @@ void write_transport_impacts(const fs::path& run) {
   fs::create_directories(run / "transport/rpm2000");
   const double t = 0.5 * kPi / (2000 * 2 * kPi / 60);
   spit(run / "transport/rpm2000/impacts.csv",
-       "time_s,particle_id,surface,x_m,y_m,z_m,contact_x_m,contact_y_m,contact_z_m,normal_x,normal_"
-       "y,normal_z,"
-       "vrel_x_m_s,vrel_y_m_s,vrel_z_m_s,speed_m_s,normal_speed_m_s,tangential_speed_m_s,angle_deg,"
-       "surface_speed_m_s,"
-       "particle_speed_m_s,axis_distance_m\n" +
+       std::string(kImpactsCsvHeader) +
            row(1, t, {-0.021, 0.62, 0}, {0, -5, 0}, {-0.01, 0.62, 0}, {-1, 0, 0}) +
            row(2, t, {0.2, 0.95, 0}, {60, 0, 0}, {0.2, 0.94, 0}, {0, 1, 0}));
 }

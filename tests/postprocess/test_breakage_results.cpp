@@ -57,6 +57,29 @@ ImpactResult MakeImpact(double v, int repeat, int n = 10, int k = 4) {
   return AnalyseImpact(e, b, spec);
 }
 
+TEST(ImpactPieces, ReadBackFromAnImpactFileAsWritten) {
+  const std::string path = (TestDir() / "impact.h5").string();
+  const ImpactResult r = MakeImpact(40.0, 0, 10, 4);
+  WriteBreakageH5(path, {r});
+  const ImpactPieces p = ReadImpactPieces(path);
+  ASSERT_EQ(p.mass_kg.size(), r.fragments.size());
+  const double d_ref = EquivalentDiameter(r.summary.lump_mass_kg, kRho);
+  for (std::size_t k = 0; k < r.fragments.size(); ++k) {
+    EXPECT_DOUBLE_EQ(p.mass_kg[k], r.fragments[k].mass);
+    EXPECT_DOUBLE_EQ(p.d_rel[k], r.fragments[k].diameter / d_ref);
+  }
+  // A file of two impacts is not one run's.
+  const std::string two = (TestDir() / "two.h5").string();
+  WriteBreakageH5(two, {r, MakeImpact(20.0, 1)});
+  try {
+    ReadImpactPieces(two);
+    ADD_FAILURE() << "expected a PostError";
+  } catch (const PostError& e) {
+    EXPECT_NE(std::string(e.what()).find("2 impacts"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(two), std::string::npos) << e.what();
+  }
+}
+
 TEST(SummaryCsv, HeaderStartsWithTheRequiredColumnsInOrder) {
   const auto dir = TestDir();
   AppendSummaryCsv((dir / "summary.csv").string(), MakeImpact(150.0, 0).summary);

@@ -267,5 +267,56 @@ TEST(PopulationBalance, SieveSeriesAndRepresentativeSizes) {
   EXPECT_EQ(s.name(2), "below-10 mm");
 }
 
+// The decision: the lowest rotor speed whose product P80 meets a target.
+TEST(LowestSpeedMeetingP80, InterpolatesLinearlyInRpmWhereP80CrossesTheTarget) {
+  // P80 12, 9, 6, 5 mm at 1000..2500 rpm (given out of order); a 7 mm target
+  // is crossed between 1500 (9 mm) and 2000 rpm (6 mm): 1500 + 2/3 x 500.
+  const auto d = LowestSpeedMeetingP80({{2000, 6}, {1000, 12}, {2500, 5}, {1500, 9}}, 7.0);
+  EXPECT_EQ(d.kind, TargetDecision::Kind::crossed);
+  EXPECT_NEAR(d.rpm, 1500 + 500 * 2.0 / 3.0, 1e-9);
+  EXPECT_EQ(d.below_rpm, 1500);
+  EXPECT_EQ(d.above_rpm, 2000);
+  EXPECT_TRUE(d.interpolated);
+  EXPECT_TRUE(d.met_above);
+  EXPECT_EQ(DecisionSentence(d), "met from 1833 rpm (interpolated between 1500 and 2000 rpm)");
+  // A target met exactly at a simulated speed: that speed.
+  EXPECT_NEAR(LowestSpeedMeetingP80({{1000, 12}, {1500, 9}}, 9.0).rpm, 1500, 1e-9);
+}
+
+TEST(LowestSpeedMeetingP80, MetEverywhereOrNowhereSaysSo) {
+  const auto all = LowestSpeedMeetingP80({{1000, 4}, {1500, 3}}, 7.0);
+  EXPECT_EQ(all.kind, TargetDecision::Kind::met_at_lowest);
+  EXPECT_EQ(all.rpm, 1000);
+  EXPECT_EQ(DecisionSentence(all), "met at every simulated speed: lowest simulated 1000 rpm");
+  const auto none = LowestSpeedMeetingP80({{1000, 12}, {1500, 9}}, 7.0);
+  EXPECT_EQ(none.kind, TargetDecision::Kind::not_met);
+  EXPECT_EQ(DecisionSentence(none), "not met at any simulated speed");
+  // One speed only.
+  EXPECT_EQ(LowestSpeedMeetingP80({{2000, 6}}, 7.0).kind, TargetDecision::Kind::met_at_lowest);
+}
+
+TEST(LowestSpeedMeetingP80, NoSteadyStateBelowAndAP80ThatRisesAgain) {
+  const double inf = HUGE_VAL;
+  // No steady state at 1000 rpm: nothing to interpolate from.
+  const auto d = LowestSpeedMeetingP80({{1000, inf}, {1500, 6}}, 7.0);
+  EXPECT_EQ(d.kind, TargetDecision::Kind::crossed);
+  EXPECT_FALSE(d.interpolated);
+  EXPECT_EQ(d.rpm, 1500);
+  EXPECT_EQ(DecisionSentence(d),
+            "met from 1500 rpm (no steady state at 1000 rpm to interpolate from)");
+  // Met at 1500 but not again at 2500 rpm: said.
+  const auto up = LowestSpeedMeetingP80({{1000, 8}, {1500, 6}, {2000, 6.5}, {2500, 7.5}}, 7.0);
+  EXPECT_FALSE(up.met_above);
+  EXPECT_EQ(up.first_unmet_above, 2500);
+  EXPECT_NE(DecisionSentence(up).find("but not at 2500 rpm"), std::string::npos);
+}
+
+TEST(LowestSpeedMeetingP80, BadInputIsAnError) {
+  EXPECT_THROW(LowestSpeedMeetingP80({}, 7.0), PostError);
+  EXPECT_THROW(LowestSpeedMeetingP80({{1000, 8}}, 0.0), PostError);
+  const std::string e = ErrorOf([] { LowestSpeedMeetingP80({{1000, 8}, {1000, 6}}, 7.0); });
+  EXPECT_NE(e.find("1000 rpm given twice"), std::string::npos) << e;
+}
+
 }  // namespace
 }  // namespace mill::post

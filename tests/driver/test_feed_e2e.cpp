@@ -1,0 +1,238 @@
+// A case with a feed end to end on the tiny mill: one 40-element lump per
+// rotor speed struck in the turning mill (stage 1's strike written by hand),
+// then the feed's population balance: the breakage matrix of the lump's
+// class measured from the run's pieces, the coarser feed class scaled, and
+// the closed circuit's steady product per speed (circuit.json, circuit.csv)
+// and the lowest speed that meets feed.target_p80_mm, in the report's
+// headline.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "e2e_util.h"
+#include "postprocess/breakage_results.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using namespace mill::e2e;
+using nlohmann::json;
+
+const std::string kData = MILL_TEST_DATA;
+const std::vector<double> kRpm = {2000, 2500};
+
+// Per rotor speed, one lump falling at 5 m/s onto plate 0's leading face,
+// which points up at t = (pi/2) / omega (as in test_in_mill_e2e.cpp).
+void write_transport_impacts(const fs::path& run) {
+  for (double rpm : kRpm) {
+    const fs::path d = run / fmt::format("transport/rpm{:g}", rpm);
+    fs::create_directories(d);
+    const double t = 0.5 * M_PI / (rpm * 2 * M_PI / 60);
+    spit(d / "impacts.csv",
+         std::string(kImpactsCsvHeader) + tiny_strike_row(rpm, 1, t, {-0.021, 0.62, 0}, {0, -5, 0},
+                                                          {-0.01, 0.62, 0}, {-1, 0, 0}));
+  }
+}
+
+class Feed : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(scratch("feed"));
+    write_transport_impacts(*dir_);
+    // A scripted flow report at 2000 rpm: the gas takes 30 kW at the shaft.
+    fs::create_directories(*dir_ / "flow/rpm2000");
+    spit(*dir_ / "flow/rpm2000/flow_report.json",
+         R"({"shaft": {"torque_Nm": 143.2, "power_W": 30000.0}})");
+    status_ = orchestrate(
+        "--case " + kData + "/tiny_feed.yaml --stage breakage --output " + dir_->string(),
+        *dir_ / "breakage.log");
+    // The report would draw the flow's geometry and convergence from files
+    // this scripted flow lacks.
+    fs::remove_all(*dir_ / "flow");
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static fs::path* dir_;
+  static int status_;
+  fs::path stage() const { return *dir_ / "breakage"; }
+  json read(const std::string& f) const { return json::parse(slurp(stage() / f)); }
+};
+fs::path* Feed::dir_ = nullptr;
+int Feed::status_ = -1;
+
+TEST_F(Feed, BreakageMatrixPerRotorSpeedFromTheInMillPieces) {
+  ASSERT_EQ(status_, 0) << slurp(*dir_ / "breakage.log");
+  const json m = read("breakage_matrix.json");
+  // Sieves 2 .. 31.5 mm: 8 classes, coarsest first; the 20 mm lump is in
+  // class 1 (16-22.4 mm).
+  ASSERT_EQ(m.at("classes").size(), 8u);
+  ASSERT_EQ(m.at("rotor_speeds").size(), kRpm.size());
+  for (const auto& s : m.at("rotor_speeds")) {
+    const auto b = s.at("matrix").get<std::vector<std::vector<double>>>();
+    const auto& cols = s.at("columns");
+    EXPECT_EQ(cols[1].at("origin"), "measured") << s.dump();
+    EXPECT_EQ(cols[1].at("lumps").get<int>(), 1);
+    EXPECT_EQ(cols[0].at("origin"), "scaled");
+    EXPECT_EQ(cols[0].at("scaled_from_class").get<int>(), 1);
+    EXPECT_EQ(cols[7].at("origin"), "finest");
+    for (size_t j = 0; j < 8; ++j) {
+      double sum = 0;
+      for (size_t i = 0; i < 8; ++i) {
+        if (i < j) {
+          EXPECT_EQ(b[i][j], 0.0);
+        }
+        EXPECT_GE(b[i][j], 0.0);
+        sum += b[i][j];
+      }
+      EXPECT_NEAR(sum, 1.0, 1e-12) << "column " << j;
+    }
+    // The measured column is the run's pieces binned by size: recomputed
+    // here from its impact.h5 (d/D x 20 mm) on the sieves.
+    const fs::path job = stage() / fmt::format("jobs/rpm{:g}_mill_p1", s.at("rpm").get<double>());
+    const auto p = mill::post::ReadImpactPieces((job / "impact.h5").string());
+    const std::vector<double> upper = {31.5, 22.4, 16, 11.2, 8, 5.6, 4, 2};
+    std::vector<double> want(8, 0.0);
+    double total = 0;
+    for (size_t k = 0; k < p.mass_kg.size(); ++k) {
+      const double x = 20 * p.d_rel[k];
+      size_t i = 1;  // nothing coarser than the lump's class
+      while (i + 1 < 8 && x < upper[i + 1]) ++i;
+      want[i] += p.mass_kg[k];
+      total += p.mass_kg[k];
+    }
+    for (size_t i = 0; i < 8; ++i) EXPECT_NEAR(b[i][1], want[i] / total, 1e-12) << i;
+    // The struck lump broke: not all of it stayed in its class.
+    EXPECT_LT(b[1][1], 1.0) << s.dump();
+  }
+  EXPECT_NE(slurp(stage() / "breakage_matrix.csv").find("rpm,from_class,from_upper_mm"),
+            std::string::npos);
+}
+
+TEST_F(Feed, ClosedCircuitPerRotorSpeedWithProductP80LoadAndResidual) {
+  ASSERT_EQ(status_, 0) << slurp(*dir_ / "breakage.log");
+  const json c = read("circuit.json");
+  EXPECT_EQ(c.at("feed").at("rate_t_h").get<double>(), 20.0);
+  EXPECT_EQ(c.at("feed").at("cut_size_mm").get<double>(), 8.0);
+  ASSERT_EQ(c.at("rotor_speeds").size(), kRpm.size());
+  const json m = read("breakage_matrix.json");
+  for (size_t k = 0; k < kRpm.size(); ++k) {
+    const json& e = c.at("rotor_speeds")[k];
+    EXPECT_EQ(e.at("rpm").get<double>(), kRpm[k]);
+    ASSERT_TRUE(e.at("steady").get<bool>()) << e.dump(2);
+    // The product leaves through the 8 mm grate: nothing coarser in it, and
+    // it carries the whole feed at steady state.
+    const auto prod = e.at("product_t_h").get<std::vector<double>>();
+    ASSERT_EQ(prod.size(), 8u);
+    double total = 0;
+    for (size_t i = 0; i < prod.size(); ++i) {
+      total += prod[i];
+      if (i >= 4) {
+        EXPECT_EQ(prod[i], 0.0) << "above the cut: sieve index " << i;
+      }
+    }
+    EXPECT_NEAR(total, 20.0, 1e-9 * 20);
+    EXPECT_LE(e.at("mass_balance_residual").get<double>(), 1e-9);
+    EXPECT_NEAR(e.at("passing_percent").back().get<double>(), 100.0, 1e-9);
+    ASSERT_TRUE(e.at("p80_mm").is_number()) << e.dump(2);
+    EXPECT_LE(e.at("p80_mm").get<double>(), 8.0);
+    EXPECT_GE(e.at("p80_mm").get<double>(), e.at("p50_mm").get<double>());
+    // The circulating load: what the cut returned over the fresh feed.
+    const auto ret = e.at("returned_t_h").get<std::vector<double>>();
+    double returned = 0;
+    for (double r : ret) returned += r;
+    EXPECT_NEAR(e.at("circulating_load").get<double>(), returned / 20.0, 1e-12);
+    // The coarsest class (22.4-31.5 mm) gets only fresh feed, 8 t/h:
+    // m0 = f0 / (1 - b00) (c = 1), from the matrix of the same speed.
+    const double b00 = m.at("rotor_speeds")[k].at("matrix")[0][0].get<double>();
+    EXPECT_NEAR(e.at("mill_input_t_h")[7].get<double>(), 8.0 / (1.0 - b00), 1e-9);
+  }
+  EXPECT_NE(slurp(stage() / "circuit.csv")
+                .find("rpm,class,lower_mm,upper_mm,feed_t_h,mill_input_t_h,returned_t_h,"
+                      "product_t_h,product_passing_percent"),
+            std::string::npos);
+
+  // The report: a row per rotor speed with the closed circuit's P80.
+  ASSERT_EQ(
+      orchestrate("--case " + kData + "/tiny_feed.yaml --stage report --output " + dir_->string(),
+                  *dir_ / "report.log"),
+      0)
+      << slurp(*dir_ / "report.log");
+  const std::string html = slurp(*dir_ / "report/index.html");
+  EXPECT_NE(html.find("product P80, closed circuit, 2000 rpm"), std::string::npos);
+  const json summary = json::parse(slurp(*dir_ / "report/summary.json"));
+  const json h = summary.at("headline").at("circuit");
+  EXPECT_EQ(h.at("rpm2500").at("p80_mm"), c.at("rotor_speeds")[1].at("p80_mm"));
+  EXPECT_TRUE(h.at("rpm2000").contains("circulating_load"));
+}
+
+TEST_F(Feed, DecisionOnTheTargetP80FromTheSimulatedSpeeds) {
+  ASSERT_EQ(status_, 0) << slurp(*dir_ / "breakage.log");
+  const json c = read("circuit.json");
+  const json& dec = c.at("decision");
+  EXPECT_EQ(dec.at("target_p80_mm").get<double>(), 6.0);
+  // The decision from the two speeds' P80 (both steady: checked above).
+  const double p0 = c.at("rotor_speeds")[0].at("p80_mm").get<double>();
+  const double p1 = c.at("rotor_speeds")[1].at("p80_mm").get<double>();
+  std::string want;
+  if (p0 <= 6.0) {
+    EXPECT_EQ(dec.at("kind"), "met_at_lowest");
+    want = p1 <= 6.0 ? "met at every simulated speed: lowest simulated 2000 rpm"
+                     : "met at the lowest simulated speed, 2000 rpm, but not at 2500 rpm";
+  } else if (p1 <= 6.0) {
+    EXPECT_EQ(dec.at("kind"), "crossed");
+    const double rpm = 2000 + (6.0 - p0) / (p1 - p0) * 500;
+    EXPECT_NEAR(dec.at("rpm").get<double>(), rpm, 1e-9);
+    want = fmt::format("met from {:.0f} rpm (interpolated between 2000 and 2500 rpm)", rpm);
+  } else {
+    EXPECT_EQ(dec.at("kind"), "not_met");
+    EXPECT_TRUE(dec.at("rpm").is_null());
+    want = "not met at any simulated speed";
+  }
+  EXPECT_EQ(dec.at("sentence").get<std::string>(), want);
+  EXPECT_TRUE(fs::exists(stage() / "plots/circuit_p80_vs_rpm.png"));
+
+  // The report's headline row and summary.json carry it.
+  if (!fs::exists(*dir_ / "report/index.html")) {
+    ASSERT_EQ(
+        orchestrate("--case " + kData + "/tiny_feed.yaml --stage report --output " + dir_->string(),
+                    *dir_ / "report.log"),
+        0)
+        << slurp(*dir_ / "report.log");
+  }
+  const std::string html = slurp(*dir_ / "report/index.html");
+  EXPECT_NE(html.find("lowest rotor speed for a product P80 &lt;= 6 mm"), std::string::npos);
+  EXPECT_NE(html.find(want), std::string::npos) << want;
+  const json summary = json::parse(slurp(*dir_ / "report/summary.json"));
+  EXPECT_EQ(summary.at("headline").at("circuit_decision").at("sentence"), want);
+}
+
+TEST_F(Feed, EnergyPerTonneAgainstItsClosedForm) {
+  ASSERT_EQ(status_, 0) << slurp(*dir_ / "breakage.log");
+  const json c = read("circuit.json");
+  for (const auto& e : c.at("rotor_speeds")) {
+    const double rpm = e.at("rpm").get<double>();
+    const json run =
+        json::parse(slurp(stage() / fmt::format("jobs/rpm{:g}_mill_p1/in_mill.json", rpm)));
+    const double w = run.at("energy").at("work_beater_J").get<double>() /
+                     run.at("element_mass_kg").get<double>();  // J per kg
+    ASSERT_GT(w, 0.0) << run.dump(2);
+    // kWh/t = (P_gas [kW] + w [J/kg] x 20 t/h x 1000 / 3600 / 1000) / 20 t/h
+    //       = P_gas / 20 + w / 3600; the scripted gas power only at 2000 rpm.
+    const double gas_kW = rpm == 2000 ? 30.0 : 0.0;
+    const json& en = e.at("energy");
+    EXPECT_NEAR(en.at("specific_energy_kWh_t").get<double>(), gas_kW / 20 + w / 3600,
+                1e-12 * (gas_kW / 20 + w / 3600))
+        << en.dump(2);
+    EXPECT_NEAR(en.at("ore_power_W").get<double>(), w * 20000.0 / 3600, 1e-9 * w);
+    EXPECT_EQ(en.at("gas_shaft_power_W").is_null(), rpm != 2000) << en.dump(2);
+  }
+  const json summary = json::parse(slurp(*dir_ / "report/summary.json"));
+  EXPECT_TRUE(
+      summary.at("headline").at("circuit").at("rpm2000").at("specific_energy_kWh_t").is_number());
+  EXPECT_NE(slurp(*dir_ / "report/index.html").find("energy per tonne of feed, 2000 rpm"),
+            std::string::npos);
+}
+
+}  // namespace
