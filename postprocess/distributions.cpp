@@ -164,6 +164,20 @@ std::optional<double> FirstCrossingBelow(const std::vector<double>& velocity,
   return std::nullopt;
 }
 
+bool BelowAtSlowest(const std::vector<SweepPoint>& points, double threshold) {
+  if (points.empty()) return false;
+  double vmin = points.front().velocity_m_s;
+  for (const auto& p : points) vmin = std::min(vmin, p.velocity_m_s);
+  double sum = 0.0;
+  int n = 0;
+  for (const auto& p : points)
+    if (p.velocity_m_s == vmin) {
+      sum += p.value;
+      ++n;
+    }
+  return sum / n < threshold;
+}
+
 // Critical velocity of the mean curve and of each repeat.
 CriticalVelocity FindCriticalVelocity(const std::vector<SweepPoint>& points, double threshold) {
   CriticalVelocity out;

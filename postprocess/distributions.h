@@ -75,6 +75,11 @@ struct CriticalVelocity {
 // stddev is the sample standard deviation (n-1), absent for fewer than two.
 CriticalVelocity FindCriticalVelocity(const std::vector<SweepPoint>& points, double threshold);
 
+// True when the repeat-averaged curve is already below `threshold` at the
+// slowest velocity of the sweep: FindCriticalVelocity then returns that
+// velocity, an upper bound of the critical one, not a crossing.
+bool BelowAtSlowest(const std::vector<SweepPoint>& points, double threshold);
+
 // The repeat-averaged curve of a sweep's points read at `velocity`: values at
 // one velocity are averaged, and the curve is linear between the velocities
 // around it. nullopt outside the swept velocities or without points. Used for

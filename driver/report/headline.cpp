@@ -183,7 +183,8 @@ void breakage_json(const fs::path& run, Problems* problems, json& h) {
                    {"critical_velocity_m_s", pick(e, "critical_velocity_m_s")},
                    {"min_m_s", pick(e, "min_m_s")},
                    {"max_m_s", pick(e, "max_m_s")},
-                   {"largest_fraction_threshold", pick(e, "threshold")}});
+                   {"largest_fraction_threshold", pick(e, "threshold")},
+                   {"upper_bound", pick(e, "upper_bound")}});
     h["breakage"]["critical_speed"] = c;
   }
   // With calibrate.starts > 1: each entry's band over the parameter sets.
@@ -196,6 +197,7 @@ void breakage_json(const fs::path& run, Problems* problems, json& h) {
                    {"sets_crossing", pick(e, "sets_crossing")},
                    {"min_m_s", pick(e, "min_m_s")},
                    {"max_m_s", pick(e, "max_m_s")},
+                   {"upper_bound", pick(e, "upper_bound")},
                    {"sets_meeting_card", pick(e, "sets_meeting_card")},
                    {"min_meeting_card_m_s", pick(e, "min_meeting_card_m_s")},
                    {"max_meeting_card_m_s", pick(e, "max_meeting_card_m_s")},
@@ -458,7 +460,10 @@ void breakage_rows(const json& h, const RowAdder& add) {
           "critical impact speed" + (num(thr) ? " (largest piece < " + percent(d(thr)) + ")" : "");
       if (num(pick(c, "angle_deg"))) what += fmt::format(", {:g} deg", d(c.at("angle_deg")));
       std::string v = "not reached in the sweep";
-      if (num(pick(c, "critical_velocity_m_s"))) {
+      if (num(pick(c, "critical_velocity_m_s")) && pick(c, "upper_bound") == true) {
+        v = "at most " + speed(d(c.at("critical_velocity_m_s"))) +
+            " m/s (shattered at the slowest speed swept: sweep slower speeds)";
+      } else if (num(pick(c, "critical_velocity_m_s"))) {
         v = speed(d(c.at("critical_velocity_m_s"))) + " m/s";
         if (num(pick(c, "min_m_s")) && num(pick(c, "max_m_s")) &&
             d(c.at("min_m_s")) < d(c.at("max_m_s")))
@@ -479,6 +484,8 @@ void breakage_rows(const json& h, const RowAdder& add) {
       if (num(pick(c, "min_m_s")) && num(pick(c, "max_m_s")))
         v = fmt::format("{}-{} m/s over {} of {} calibrations from different starts", speed(d(c.at("min_m_s"))),
                         speed(d(c.at("max_m_s"))), crossing, n);
+      if (pick(c, "upper_bound") == true)
+        v += " (a set shattered at the slowest speed swept: its value is an upper bound)";
       v += met == n ? fmt::format("; all {} meet the ore card", n)
                     : fmt::format("; {} of {} meet the ore card", met, n);
       if (num(pick(c, "min_meeting_card_m_s")) && met < n) {

@@ -109,6 +109,21 @@ TEST(CalibrationSetsBand, CriticalSpeedPerSetAndTheBand) {
   EXPECT_TRUE(j2["entries"][0]["within_15_percent"].get<bool>());
 }
 
+// A set already shattered at the slowest speed only bounds its critical
+// speed: the band is flagged and not judged within +-15 %.
+TEST(CalibrationSetsBand, ShatteredAtTheSlowestSpeedIsAnUpperBound) {
+  std::vector<breakage::SetRows> sets = {{1, linear_sweep(40.0)}, {2, linear_sweep(11.0)}};
+  const nlohmann::json primary = nlohmann::json::array(
+      {{{"angle_deg", 90.0}, {"critical_velocity_m_s", 30.0}}});
+  const auto j = breakage::calibration_sets_json(primary, sets, nullptr, 0.25, false);
+  const auto& e = j["entries"][0];
+  EXPECT_FALSE(e["sets"][0]["upper_bound"].get<bool>());
+  EXPECT_TRUE(e["sets"][1]["upper_bound"].get<bool>());  // 1 - 10/11 < 0.25 at 10 m/s
+  EXPECT_NEAR(e["sets"][1]["critical_velocity_m_s"].get<double>(), 10.0, 1e-12);
+  EXPECT_TRUE(e["upper_bound"].get<bool>());
+  EXPECT_TRUE(e["within_15_percent"].is_null());
+}
+
 TEST(CalibrationSetsBand, ASetThatNeverShattersLeavesTheBandOpen) {
   std::vector<breakage::SetRows> sets = {{1, linear_sweep(40.0)}, {2, linear_sweep(400.0)}};
   const nlohmann::json primary = nlohmann::json::array(

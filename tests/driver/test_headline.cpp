@@ -184,3 +184,15 @@ TEST(Headline, CriticalSpeedBandOverTheParameterSets) {
             "(58 m/s for that one)");
 }
 }  // namespace
+
+namespace {
+// Shattered at the slowest speed swept: the figure is an upper bound, said so.
+TEST(Headline, CriticalSpeedAtTheSlowestSpeedIsAnUpperBound) {
+  const json h = json::parse(R"({
+    "breakage": {"critical_speed": [{"angle_deg": 90, "critical_velocity_m_s": 10.0, "upper_bound": true,
+                                     "largest_fraction_threshold": 0.05}]}})");
+  const auto rows = headline_rows(h);
+  EXPECT_EQ(value_of(rows, "critical impact speed (largest piece < 5%), 90 deg"),
+            "at most 10 m/s (shattered at the slowest speed swept: sweep slower speeds)");
+}
+}  // namespace

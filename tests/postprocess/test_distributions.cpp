@@ -149,3 +149,16 @@ TEST(PassingCurve, P50AndP80OfALogUniformDistribution) {
 
 }  // namespace
 }  // namespace mill::post
+
+// Below the threshold at the slowest speed (repeats averaged): the critical
+// speed FindCriticalVelocity gives is only an upper bound.
+TEST(CriticalVelocity, BelowAtTheSlowestSpeedIsAnUpperBound) {
+  using mill::post::BelowAtSlowest;
+  using mill::post::SweepPoint;
+  const std::vector<SweepPoint> above = {{20, 0, 0.9}, {10, 0, 0.5}, {10, 1, 0.6}, {40, 0, 0.01}};
+  EXPECT_FALSE(BelowAtSlowest(above, 0.05));
+  const std::vector<SweepPoint> below = {{20, 0, 0.001}, {10, 0, 0.02}, {10, 1, 0.07}};
+  EXPECT_TRUE(BelowAtSlowest(below, 0.05));   // mean 0.045 at 10 m/s
+  EXPECT_FALSE(BelowAtSlowest(below, 0.04));  // 0.045 is not below 0.04
+  EXPECT_FALSE(BelowAtSlowest({}, 0.05));
+}

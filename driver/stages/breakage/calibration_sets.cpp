@@ -73,6 +73,7 @@ nlohmann::json calibration_sets_json(const nlohmann::json& primary_crit,
     nlohmann::json per_set = nlohmann::json::array();
     std::optional<double> lo, hi, lo_met, hi_met;
     int crossing = 0, n_met = 0;
+    bool any_upper = false;  // a set already shattered at the slowest speed
     for (const auto& s : sets) {
       std::vector<post::SweepPoint> pts;
       for (const auto& r : s.rows)
@@ -80,9 +81,12 @@ nlohmann::json calibration_sets_json(const nlohmann::json& primary_crit,
           pts.push_back({r.velocity_m_s, r.repeat, r.largest_mass_fraction});
       const auto v = post::FindCriticalVelocity(pts, threshold).of_mean_curve;
       const bool met = meets.count(s.set) ? meets[s.set] : false;
+      const bool upper = post::BelowAtSlowest(pts, threshold);
+      any_upper = any_upper || upper;
       per_set.push_back({{"set", s.set},
                          {"impacts", pts.size()},
                          {"critical_velocity_m_s", v ? nlohmann::json(*v) : nlohmann::json()},
+                         {"upper_bound", upper},
                          {"meets_card", met}});
       if (met) ++n_met;
       if (!v) continue;
@@ -99,7 +103,7 @@ nlohmann::json calibration_sets_json(const nlohmann::json& primary_crit,
     };
     const nlohmann::json ref = c["critical_velocity_m_s"];
     nlohmann::json within = nullptr;
-    if (ref.is_number() && crossing == static_cast<int>(sets.size()) && lo && hi)
+    if (ref.is_number() && crossing == static_cast<int>(sets.size()) && lo && hi && !any_upper)
       within = *lo >= (1 - kBandTolerance) * ref.get<double>() &&
                *hi <= (1 + kBandTolerance) * ref.get<double>();
     entries.push_back({{"angle_deg", c["angle_deg"]},
@@ -108,6 +112,7 @@ nlohmann::json calibration_sets_json(const nlohmann::json& primary_crit,
                        {"sets_crossing", crossing},
                        {"min_m_s", opt(lo)},
                        {"max_m_s", opt(hi)},
+                       {"upper_bound", any_upper},
                        {"sets_meeting_card", n_met},
                        {"min_meeting_card_m_s", opt(lo_met)},
                        {"max_meeting_card_m_s", opt(hi_met)},
@@ -120,8 +125,10 @@ nlohmann::json calibration_sets_json(const nlohmann::json& primary_crit,
            "the sweep's impacts repeated with each parameter set of the calibration "
            "(calibrate.starts, calibrate/sets.json); per set the critical speed of its "
            "repeat-averaged curve (the largest piece below the threshold); the band: min and max "
-           "over the sets whose sweep crosses; within_15_percent: every set within +-15 % of "
-           "set 1 (null when a set's sweep does not cross)"}};
+           "over the sets whose sweep crosses; upper_bound: a set already below the threshold at the "
+           "slowest speed swept (its value bounds the critical speed from above); "
+           "within_15_percent: every set within +-15 % of set 1 (null when a set's sweep does not "
+           "cross or only bounds it)"}};
 }
 
 void write_calibration_sets(StageContext& ctx, const std::vector<JobSpec>& set_jobs,

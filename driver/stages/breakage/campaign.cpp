@@ -84,12 +84,19 @@ nlohmann::json critical_entry(StageContext& ctx, double angle,
     e["note"] = "conditions binned from transport: every bin has its own speed and angle; pooled";
   e["critical_velocity_m_s"] =
       c.of_mean_curve ? nlohmann::json(*c.of_mean_curve) : nlohmann::json(nullptr);
+  // Shattered at the slowest speed swept: the value is an upper bound.
+  const bool upper_bound = post::BelowAtSlowest(pts, thr);
+  e["upper_bound"] = upper_bound;
+  if (upper_bound)
+    e["upper_bound_note"] =
+        "the largest piece is already below the threshold at the slowest speed of the sweep: "
+        "the critical speed is at or below it; sweep slower speeds to find it";
   e["min_m_s"] = c.min ? nlohmann::json(*c.min) : nlohmann::json(nullptr);
   e["max_m_s"] = c.max ? nlohmann::json(*c.max) : nlohmann::json(nullptr);
   ctx.progress.info(
       c.of_mean_curve
-          ? fmt::format("[breakage] critical velocity {} (largest piece < {:g}%): {:.1f} m/s{}",
-                        where, 100 * thr, *c.of_mean_curve,
+          ? fmt::format("[breakage] critical velocity {} (largest piece < {:g}%): {}{:.1f} m/s{}",
+                        where, 100 * thr, upper_bound ? "at most " : "", *c.of_mean_curve,
                         c.min && c.max && *c.min != *c.max
                             ? fmt::format(" (repeats {:.1f}-{:.1f} m/s)", *c.min, *c.max)
                             : "")
