@@ -481,9 +481,11 @@ void breakage_rows(const json& h, const RowAdder& add) {
       const int met = num(pick(c, "sets_meeting_card")) ? pick(c, "sets_meeting_card").get<int>() : 0;
       const int crossing = num(pick(c, "sets_crossing")) ? pick(c, "sets_crossing").get<int>() : 0;
       std::string v = fmt::format("no set's sweep reached it ({} sets)", n);
-      if (num(pick(c, "min_m_s")) && num(pick(c, "max_m_s")))
-        v = fmt::format("{}-{} m/s over {} of {} calibrations from different starts", speed(d(c.at("min_m_s"))),
-                        speed(d(c.at("max_m_s"))), crossing, n);
+      if (num(pick(c, "min_m_s")) && num(pick(c, "max_m_s"))) {
+        const std::string lo = speed(d(c.at("min_m_s"))), hi = speed(d(c.at("max_m_s")));
+        v = fmt::format("{} m/s over {} of {} calibrations from different starts",
+                        lo == hi ? lo : lo + "-" + hi, crossing, n);
+      }
       if (pick(c, "upper_bound") == true)
         v += " (a set shattered at the slowest speed swept: its value is an upper bound)";
       v += met == n ? fmt::format("; all {} meet the ore card", n)

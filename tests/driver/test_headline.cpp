@@ -196,3 +196,17 @@ TEST(Headline, CriticalSpeedAtTheSlowestSpeedIsAnUpperBound) {
             "at most 10 m/s (shattered at the slowest speed swept: sweep slower speeds)");
 }
 }  // namespace
+
+namespace {
+// Every set shattered at the slowest speed: one speed, said to be a bound.
+TEST(Headline, BandOfUpperBoundsReadsAsOneBound) {
+  const json h = json::parse(R"({
+    "breakage": {"critical_speed_over_sets": [{"angle_deg": 90, "sets": 3, "sets_crossing": 3,
+                                               "min_m_s": 10.0, "max_m_s": 10.0, "upper_bound": true,
+                                               "sets_meeting_card": 3}]}})");
+  const auto rows = headline_rows(h);
+  EXPECT_EQ(value_of(rows, "critical impact speed over the calibration's parameter sets, 90 deg"),
+            "10 m/s over 3 of 3 calibrations from different starts (a set shattered at the slowest "
+            "speed swept: its value is an upper bound); all 3 meet the ore card");
+}
+}  // namespace
