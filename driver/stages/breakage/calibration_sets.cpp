@@ -168,10 +168,13 @@ void write_calibration_sets(StageContext& ctx, const std::vector<JobSpec>& set_j
     ctx.progress.info(
         e["min_m_s"].is_number()
             ? fmt::format("[breakage] critical velocity {} over {} parameter sets: {:.1f}-{:.1f} "
-                          "m/s ({} of {} sets cross; {} meet the ore card)",
+                          "m/s ({} of {} sets cross; {} meet the ore card){}",
                           where, sets.size(), e["min_m_s"].get<double>(),
                           e["max_m_s"].get<double>(), e["sets_crossing"].get<int>(), sets.size(),
-                          e["sets_meeting_card"].get<int>())
+                          e["sets_meeting_card"].get<int>(),
+                          e["upper_bound"].get<bool>()
+                              ? "; a set shattered at the slowest speed swept: an upper bound"
+                              : "")
             : fmt::format("[breakage] critical velocity {}: no parameter set's sweep crosses",
                           where));
   }
