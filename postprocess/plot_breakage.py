@@ -47,6 +47,17 @@ EFFICIENCY = "comminution_efficiency"
 PASSING_NEEDED = ("velocity_m_s", "angle_deg", "sieve_mm", "passing_percent", "passing_percent_min",
                   "passing_percent_max")
 
+def read_json(path):
+    """A results JSON file; exits naming the file (and line) when it cannot be read or parsed."""
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except OSError as e:
+        sys.exit(f"{path}: cannot read ({e.strerror})")
+    except json.JSONDecodeError as e:
+        sys.exit(f"{path}:{e.lineno}: not JSON ({e.msg})")
+
+
 def read_csv(path, needed):
     """Reads a results CSV into a list of dicts of floats; exits naming a missing column."""
     try:

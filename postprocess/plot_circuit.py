@@ -18,7 +18,6 @@ Usage: plot_circuit.py --circuit breakage/circuit.json --out breakage/plots
 """
 
 import argparse
-import json
 import os
 import sys
 
@@ -26,19 +25,14 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from plot_breakage import read_json  # noqa: E402  (same folder: the results-JSON reader)
 
 NEEDED = ("rpm", "steady")
 STEADY = ("p50_mm", "p80_mm", "circulating_load", "passing_percent")
 
 
 def read_circuit(path):
-    try:
-        with open(path) as f:
-            data = json.load(f)
-    except OSError as e:
-        sys.exit(f"{path}: cannot read ({e.strerror})")
-    except json.JSONDecodeError as e:
-        sys.exit(f"{path}:{e.lineno}: not JSON ({e.msg})")
+    data = read_json(path)
     if not isinstance(data, dict) or not isinstance(data.get("rotor_speeds"), list):
         sys.exit(f"{path}: expected an object with a list 'rotor_speeds'")
     if not isinstance(data.get("sieves_mm"), list) or not data["sieves_mm"]:

@@ -17,7 +17,6 @@ Usage: plot_jk.py --points jk_points.csv --fit jk_fit.json --out DIR
 """
 
 import argparse
-import json
 import os
 import sys
 
@@ -26,7 +25,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from plot_breakage import read_csv  # noqa: E402  (same folder: the results-CSV reader)
+from plot_breakage import read_csv, read_json  # noqa: E402  (same folder: the results readers)
 
 POINT_COLUMNS = ("angle_deg", "velocity_m_s", "repeat", "ecs_kWh_t", "t10_percent", "t10_resolved")
 
@@ -38,13 +37,7 @@ def read_points(path):
 
 def read_fit(path):
     """jk_fit.json: a list with one entry per angle (angle_deg null: pooled)."""
-    try:
-        with open(path) as f:
-            data = json.load(f)
-    except OSError as e:
-        sys.exit(f"{path}: cannot read ({e.strerror})")
-    except json.JSONDecodeError as e:
-        sys.exit(f"{path}:{e.lineno}: not JSON ({e.msg})")
+    data = read_json(path)
     if not isinstance(data, list):
         sys.exit(f"{path}: expected a list of fits (one per impact angle)")
     for i, e in enumerate(data):

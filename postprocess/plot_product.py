@@ -22,7 +22,6 @@ Usage: plot_product.py --product breakage/product.json --out breakage/plots
 """
 
 import argparse
-import json
 import os
 import sys
 
@@ -32,19 +31,14 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import FuncFormatter  # noqa: E402
+from plot_breakage import read_json  # noqa: E402  (same folder: the results-JSON reader)
 
 NEEDED = ("rpm", "fraction_edges_rel", "fraction_mass", "fully_shredded_mass_fraction",
           "largest_piece_mass_fraction", "t10_percent", "sieves_mm", "passing_percent", "p50_mm", "p80_mm")
 
 
 def read_product(path):
-    try:
-        with open(path) as f:
-            data = json.load(f)
-    except OSError as e:
-        sys.exit(f"{path}: cannot read ({e.strerror})")
-    except json.JSONDecodeError as e:
-        sys.exit(f"{path}:{e.lineno}: not JSON ({e.msg})")
+    data = read_json(path)
     if not isinstance(data, list) or not data:
         sys.exit(f"{path}: expected a non-empty list of per-rpm products")
     for i, e in enumerate(data):
