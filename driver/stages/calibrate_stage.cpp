@@ -135,10 +135,10 @@ void Calibration::run() {
   // fit keeps the model), then the checks.
   const bool primary = start_ == 1;
   const CheckTargets check_for = primary ? check_targets(ore_) : CheckTargets{};
-  const std::vector<double> pressures =
-      primary ? d_.reals("calibrate.confining_pressures") : std::vector<double>{};
-  const double n_checks = static_cast<double>(pressures.size()) +
-                          (check_for.fracture_toughness ? 1.0 : 0.0);
+  const double n_checks =
+      primary ? static_cast<double>(d_.reals("calibrate.confining_pressures").size()) +
+                    (check_for.fracture_toughness ? 1.0 : 0.0)
+              : 0.0;
   const bool sensitivity = primary && d_.boolean("calibrate.sensitivity");
   const bool rate_check = primary && d_.boolean("calibrate.rate_check");
   const double n_sensitivity =

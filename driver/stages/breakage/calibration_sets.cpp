@@ -13,6 +13,7 @@
 #include "lump/material.h"
 #include "postprocess/distributions.h"
 #include "progress.h"
+#include "stages/breakage/in_mill_runs.h"
 
 namespace mill::breakage {
 namespace fs = std::filesystem;
@@ -36,7 +37,7 @@ void plan_calibration_sets(const StageContext& ctx, Plan& p) {
   if (starts < 2) return;
   std::vector<JobSpec> primary;
   for (const auto& j : p.jobs)
-    if (calibration_set_of(j) == 1 && j.inputs.contains("velocity")) primary.push_back(j);
+    if (calibration_set_of(j) == 1 && !is_in_mill_job(j)) primary.push_back(j);
   for (int k = 2; k <= starts; ++k) {
     if (!fs::exists(set_calibration_file(ctx.run_dir, k))) {
       p.note += (p.note.empty() ? "" : "; ") +
