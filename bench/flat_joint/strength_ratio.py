@@ -1,7 +1,9 @@
 """UCS, Brazilian tensile strength and their ratio for each model run by
 strength_ratio.sh: UCS = peak of the mean platen force over the cylinder's
 cross-section; T = 2 P / (pi D t) at the peak load P (ISRM Brazilian test);
-E = secant modulus at half the peak (gauge length from ucs_info.txt)."""
+E = secant modulus at half the peak (gauge length from ucs_info.txt);
+K_IC of the semi-circular bend test when it ran (Kuruppu et al. 2014,
+eqs. 1-2, as post::ScbToughness)."""
 import math
 import sys
 
@@ -37,17 +39,35 @@ def analyse(out, model):
     load = max(0.5 * (r[3] + r[4]) for r in bc)
     tensile = 2 * load / (math.pi * float(bi["diameter"]) * float(bi["thickness"]))
     peaked = k + 1 < len(stress)
-    return ucs, tensile, young, peaked
+    return ucs, tensile, young, peaked, toughness(out, model)
+
+
+def toughness(out, model):
+    """K_IC = Y' P sqrt(pi a) / (2 R B), Y' of Kuruppu et al. (2014), eq. 2;
+    None when the SCB test did not run."""
+    try:
+        si = info(f"{out}/{model}/scb/scb_info.txt")
+    except FileNotFoundError:
+        return None
+    sc = curve(f"{out}/{model}/scb/scb_curve.txt")
+    load = max(0.5 * (r[3] + r[4]) for r in sc)
+    r, b = float(si["radius"]), float(si["thickness"])
+    a, s = float(si["notch"]), float(si["half_span"])
+    beta, sr = a / r, s / r
+    y = -1.297 + 9.516 * sr - (0.47 + 16.457 * sr) * beta + (1.071 + 34.401 * sr) * beta ** 2
+    return y * load * math.sqrt(math.pi * a) / (2 * r * b)
 
 
 def main():
     out, models = sys.argv[1], sys.argv[2:]
-    print("| model | UCS [MPa] | tensile [MPa] | UCS/T | E (secant at UCS/2) [GPa] | UCS peaked |")
-    print("|---|---|---|---|---|---|")
+    print("| model | UCS [MPa] | tensile [MPa] | UCS/T | E (secant at UCS/2) [GPa] | UCS peaked "
+          "| K_IC [MPa m^0.5] |")
+    print("|---|---|---|---|---|---|---|")
     for m in models:
-        ucs, t, e, peaked = analyse(out, m)
+        ucs, t, e, peaked, k = analyse(out, m)
+        kic = "-" if k is None else f"{k / 1e6:.3f}"
         print(f"| {m} | {ucs / 1e6:.1f} | {t / 1e6:.2f} | {ucs / t:.2f} | {e / 1e9:.1f} | "
-              f"{'yes' if peaked else 'no (cap reached)'} |")
+              f"{'yes' if peaked else 'no (cap reached)'} | {kic} |")
 
 
 if __name__ == "__main__":

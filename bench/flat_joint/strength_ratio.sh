@@ -15,7 +15,8 @@
 # unbonded_frac, bond_gap (interfaces out to this surface gap / min radius),
 # fj_extra (more keywords for the flat joint, e.g. fj_extra="joint_friction 0.8"),
 # bond_extra (more keywords for both models, e.g. bond_extra="unbonded_seed 7"),
-# models="parallel flatjoint", ...).
+# models="parallel flatjoint", tests="ucs brazilian scb" to add the
+# semi-circular bend test of the toughness check, ...).
 set -eu
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
@@ -32,7 +33,7 @@ ucs_target=50e6 tensile_target=5e6
 bond_modulus=9.9925879e10 stiffness_ratio=3.9440781 bond_tensile=24943466
 bond_cohesion=49886932 bond_friction=30 moment_factor=0 radius_mult=1.0
 bond_gap=0.15 max_bonds=16 rate=2 elements="1 3" joint_friction=-1 unbonded_frac=0
-fj_extra="" bond_extra="" models="parallel flatjoint"
+fj_extra="" bond_extra="" models="parallel flatjoint" tests="ucs brazilian"
 ucs_r=0.0131578 disc_r=0.0209757
 for kv in "$@"; do
   key=${kv%%=*}
@@ -87,6 +88,10 @@ for m in $models; do
   start=$(date +%s)
   run_test ucs "$ucs_r" "$(awk "BEGIN{print $ucs_target / $E}")" "$m" 4.0
   run_test brazilian "$disc_r" "$(awk "BEGIN{print 4 * $tensile_target / $E}")" "$m" 5.0
+  # The toughness check's half disc (driver/stages/calibrate/lab_runs.cpp, LabBench::scb).
+  case " $tests " in *" scb "*)
+    run_test scb "$disc_r" "$(awk "BEGIN{print 4 * $tensile_target / $E}")" "$m" 10.0 ;;
+  esac
   echo "$m: $(($(date +%s) - start)) s" > "$out/$m/seconds.txt"
 done
 /usr/bin/python3 "$here/strength_ratio.py" "$out" $models

@@ -463,6 +463,12 @@ std::vector<KeyDef> calibrate_keys() {
                 "band of critical impact speeds the ore card leaves open (docs/calibration.md, \"Parameter "
                 "sets from different starts\"). Each start costs a fit; each set, the sweep's impacts again"),
             1, false, 8, false),
+      key("calibrate.fit_toughness", T::Bool, "", "true",
+          "With flat joints (lump.bond_model: flat_joint) and an ore card that gives fracture_toughness: "
+          "every iteration also runs the semi-circular bend test and the fit aims at K_IC as a fifth target "
+          "(its lever: the bond tensile strength against the cohesion). false: K_IC is a check after the "
+          "fit only, as it always is for the parallel bond (docs/calibration.md, \"The toughness as a "
+          "target\")"),
       key("calibrate.rate_check", T::Bool, "", "true",
           "After the fit, repeat the UCS test at half the strain rate (quasi-static check)"),
       key("calibrate.sensitivity", T::Bool, "", "true",

@@ -38,6 +38,25 @@ using namespace calibrate;
 // local linear model (calibrate/local_model.h) instead of one secant each.
 constexpr int kDeckVersion = 6;
 
+// True when the fit aims at the card's K_IC too (calibrate.fit_toughness,
+// flat joints, the card gives fracture_toughness): docs/calibration.md,
+// "The toughness as a target".
+bool fits_toughness(const config::CaseConfig& cfg) {
+  return cfg.doc.boolean("calibrate.fit_toughness") &&
+         estimate_bond_params(cfg.ore, cfg.doc).model == BondModel::flat_joint &&
+         cfg.ore.has("fracture_toughness");
+}
+
+// The fit's targets: the card's four macro properties, and its K_IC when
+// the fit aims at it.
+Targets targets_of(const config::CaseConfig& cfg) {
+  const config::Document& o = cfg.ore;
+  Targets t{o.real("youngs_modulus"), o.real("poisson_ratio"), o.real("ucs"),
+            o.real("tensile_strength")};
+  if (fits_toughness(cfg)) t.toughness = o.real("fracture_toughness");
+  return t;
+}
+
 // True when the ore card carries a complete calibrated.* section made with
 // the case's bond model and layout (lump.bond_model, lump.joint_*): another
 // model's parameters mean nothing to this one, not even as a start.
@@ -70,9 +89,7 @@ class Calibration {
         dir_(dir),
         d_(ctx.cfg.doc),
         ore_(ctx.cfg.ore),
-        fit_({ore_.real("youngs_modulus"), ore_.real("poisson_ratio"), ore_.real("ucs"),
-              ore_.real("tensile_strength")},
-             d_.real("calibrate.tolerance")) {
+        fit_(targets_of(ctx.cfg), d_.real("calibrate.tolerance")) {
     n_ = d_.integer("calibrate.n_elements");
     rate_ = d_.real("calibrate.strain_rate");
     max_it_ = static_cast<int>(d_.integer("calibrate.max_iterations"));
@@ -130,9 +147,10 @@ void Calibration::run() {
         "input_hash): "
         "starting the fit from it");
   }
-  // Steps of the job: 2 tests per iteration, the half-rate UCS (twice as
-  // long), 2 tests per lever of the sensitivities (the model's levers: the
-  // fit keeps the model), then the checks.
+  // Steps of the job: 2 tests per iteration (3 with the bend test of the
+  // toughness fit), the half-rate UCS (twice as long), 2 tests per lever of
+  // the sensitivities (the model's levers: the fit keeps the model), then
+  // the checks.
   const bool primary = start_ == 1;
   const CheckTargets check_for = primary ? check_targets(ore_) : CheckTargets{};
   const double n_checks =
@@ -143,27 +161,40 @@ void Calibration::run() {
   const bool rate_check = primary && d_.boolean("calibrate.rate_check");
   const double n_sensitivity =
       sensitivity ? 2.0 * static_cast<double>(sensitivity_levers(p).size()) : 0.0;
+  const double per_it = fit_.fits_toughness() ? 3.0 : 2.0;
   const double steps_total =
-      2.0 * max_it_ + (rate_check ? 2.0 : 0.0) + n_sensitivity + n_checks;
+      per_it * max_it_ + (rate_check ? 2.0 : 0.0) + n_sensitivity + n_checks;
   for (int k = 1; k <= max_it_; ++k) {
     Iteration it;
     it.p = p;
     it.ucs = lab.ucs(p, rate_,
                      {fmt::format("it{}_ucs", k), fmt::format("iteration {}/{}: UCS", k, max_it_),
-                      (2.0 * (k - 1)) / steps_total});
+                      (per_it * (k - 1)) / steps_total});
     it.br = lab.brazilian(
         p, rate_,
         {fmt::format("it{}_brazilian", k), fmt::format("iteration {}/{}: Brazilian", k, max_it_),
-         (2.0 * (k - 1) + 1) / steps_total});
+         (per_it * (k - 1) + 1) / steps_total});
+    if (fit_.fits_toughness())
+      it.scb = lab.scb(p, rate_,
+                       {fmt::format("it{}_scb", k),
+                        fmt::format("iteration {}/{}: semi-circular bend", k, max_it_),
+                        (per_it * (k - 1) + 2) / steps_total});
     fit_.score(it);
     hist.push_back(it);
     ctx_.progress.info(fmt::format(
         "[calibrate] iteration {}/{}: E {:.2f} GPa (target {:.2f}), nu {:.3f} ({:.2f}), UCS {:.1f} "
         "MPa ({:.1f}), tensile "
-        "{:.2f} MPa ({:.2f}){} [{:.0f} s + {:.0f} s]",
+        "{:.2f} MPa ({:.2f}){}{} [{:.0f} s + {:.0f} s{}]",
         k, max_it_, it.ucs.r.youngs_modulus / 1e9, t.E / 1e9, it.ucs.r.poisson_ratio, t.nu,
         it.ucs.r.ucs / 1e6, t.ucs / 1e6, it.br.r.tensile_strength / 1e6, t.tensile / 1e6,
-        it.converged ? ": all within tolerance" : "", it.ucs.seconds, it.br.seconds));
+        it.scb ? fmt::format(", K_IC {:.3f} MPa m^0.5 ({:.3f})", it.scb->r.toughness / 1e6,
+                             t.toughness / 1e6)
+               : "",
+        it.converged ? ": all within tolerance" : "", it.ucs.seconds, it.br.seconds,
+        it.scb ? fmt::format(" + {:.0f} s", it.scb->seconds) : ""));
+    if (it.scb && !it.scb->peaked)
+      notes.push_back(fmt::format(
+          "iteration {}: the semi-circular bend test reached its cap still loading", k));
     if (!it.ucs.peaked)
       notes.push_back(
           fmt::format("iteration {}: the UCS test reached its strain cap still loading", k));
@@ -178,11 +209,11 @@ void Calibration::run() {
   if (rate_check)
     o.half = lab.ucs(
         hist[o.best].p, 0.5 * rate_,
-        {"rate_check_ucs", "rate check: UCS at half the strain rate", 2.0 * max_it_ / steps_total});
+        {"rate_check_ucs", "rate check: UCS at half the strain rate", per_it * max_it_ / steps_total});
   // Sensitivities: each lever stepped alone from the best parameters.
   if (sensitivity) {
     o.sensitivity =
-        run_sensitivity(lab, hist[o.best].p, rate_, (2.0 * max_it_ + 2.0) / steps_total,
+        run_sensitivity(lab, hist[o.best].p, rate_, (per_it * max_it_ + 2.0) / steps_total,
                         1.0 / steps_total);
     const Noise noise = sensitivity_noise(hist[o.best].ucs, o.half ? &*o.half : nullptr);
     for (const LeverRun& run : o.sensitivity) {
@@ -198,7 +229,7 @@ void Calibration::run() {
   if (primary)
     o.checks = run_checks(lab, hist[o.best].p, hist[o.best].ucs, rate_,
                           confining_pressures(d_, hist[o.best].ucs.r.ucs), check_for,
-                          (2.0 * max_it_ + 2.0 + n_sensitivity) / steps_total, 1.0 / steps_total);
+                          (per_it * max_it_ + 2.0 + n_sensitivity) / steps_total, 1.0 / steps_total);
   o.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_outputs(ctx_, dir_, fit_, o);
 }
@@ -253,6 +284,9 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
   // The number of starts is not an input of any one fit (the primary fit
   // keeps its job id whatever calibrate.starts is).
   in.erase("calibrate.starts");
+  // The toughness fit is an input only where it acts (flat joints, a card
+  // with K_IC): a parallel-bond calibration keeps its job id.
+  if (!fits_toughness(ctx.cfg)) in.erase("calibrate.fit_toughness");
   in["ore"] = config::ore_keys(ctx.cfg.ore);
   for (const char* k : config::kOreCheckKeys)
     if (ctx.cfg.ore.has(k)) in["ore_checks"][k] = ctx.cfg.ore.real(k);

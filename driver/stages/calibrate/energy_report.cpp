@@ -42,6 +42,7 @@ std::vector<const LabRun*> lab_runs(const Outcome& o) {
   for (const Iteration& it : o.hist) {
     runs.push_back(&it.ucs);
     runs.push_back(&it.br);
+    if (it.scb) runs.push_back(&*it.scb);
   }
   if (o.half) runs.push_back(&*o.half);
   for (const LeverRun& l : o.sensitivity) {
@@ -94,7 +95,8 @@ std::string energy_markdown(const Outcome& o) {
   const Iteration* best = o.hist.empty() ? nullptr : &o.hist[o.best];
   for (const LabRun* r : runs) {
     const post::LedgerSummary& e = r->energy;
-    const bool result = best && (r == &best->ucs || r == &best->br);
+    const bool result =
+        best && (r == &best->ucs || r == &best->br || (best->scb && r == &*best->scb));
     md << fmt::format(
         "| {}{} | {:.4g} | {:.4g} | {:.4g} | {:.3g} | {:.3g}% | {:.3g}% | {:.3g} | {:.3g}% |\n",
         r->tag, result ? " *" : "", e.input_J, e.work_other_J, e.bond_released_J, e.residual_J,

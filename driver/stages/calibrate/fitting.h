@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,20 +40,28 @@ inline constexpr double kUcsWeightOutOfReach = 0.05;
 // while the card's ratio is more than this factor above the one reached.
 inline constexpr double kCoarseLeverGap = 1.2;
 
-// One iteration: the bond parameters tried, both tests, their errors.
+// One iteration: the bond parameters tried, both tests (and the
+// semi-circular bend test when the toughness is a target), their errors.
 struct Iteration {
   BondParams p;
   UcsRun ucs;
   BrazilianRun br;
+  std::optional<ScbRun> scb;
   double err_E = 0, err_ucs = 0, err_t = 0, err_nu = 0;
+  double err_kic = 0;  // relative error of K_IC (0 when not a target)
   bool converged = false;
   double score = 0;  // worst error in units of its tolerance
 };
 
 // The flat joint's local model's start: prior slopes J0, the range each
 // measured slope is kept in, the step cap per parameter (local_model.h).
+// Rows: ln E, nu, ln UCS, ln T, ln K_IC (the last used when the toughness is
+// a target).
+inline constexpr size_t kFitResponses = 5;
+using FitMat = MatN<kFitResponses>;
+using FitVec = VecN<kFitResponses>;
 struct LocalModelPrior {
-  Mat4 J0{}, lo{}, hi{};
+  FitMat J0{}, lo{}, hi{};
   Vec4 max_step{};
 };
 LocalModelPrior flat_joint_prior();
@@ -79,9 +88,12 @@ class Fitting {
                           std::vector<std::string>& notes) const;
   // Index of the iteration kept as the result.
   size_t best(const std::vector<Iteration>& hist) const;
+  // True when the toughness K_IC is a target (and each iteration runs the
+  // semi-circular bend test).
+  bool fits_toughness() const { return t_.toughness > 0; }
   // True when an iteration's responses can be fitted: E, UCS and the
-  // tensile strength finite and > 0, nu finite (a specimen that failed at
-  // once can give a negative modulus).
+  // tensile strength (and K_IC when it ran) finite and > 0, nu finite (a
+  // specimen that failed at once can give a negative modulus).
   static bool usable(const Iteration& it);
 
  private:

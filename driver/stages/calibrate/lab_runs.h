@@ -24,6 +24,9 @@ namespace mill::calibrate {
 // The ore card's macro properties: what the lab tests measure and the fit aims at.
 struct Targets {
   double E, nu, ucs, tensile;
+  // Mode-I fracture toughness K_IC [Pa m^0.5] of the card when the fit aims
+  // at it too (calibrate.fit_toughness, flat joints), 0 when not a target.
+  double toughness = 0;
 };
 
 // What every lab test gives: the deck's info line, load curve and energy ledger.

@@ -31,11 +31,12 @@ bool solve_small(std::vector<std::vector<double>> A, std::vector<double> b,
   return true;
 }
 
-Mat4 estimate_jacobian(const std::vector<ModelPoint>& pts, const Mat4& prior, double lambda,
-                       const Mat4& lo, const Mat4& hi) {
-  Mat4 J = prior;
+template <size_t Ny>
+MatN<Ny> estimate_jacobian(const std::vector<ModelPointN<Ny>>& pts, const MatN<Ny>& prior,
+                           double lambda, const MatN<Ny>& lo, const MatN<Ny>& hi) {
+  MatN<Ny> J = prior;
   if (pts.size() < 2) return J;
-  const ModelPoint& last = pts.back();
+  const ModelPointN<Ny>& last = pts.back();
   // Per row i: (sum_k du_k du_k^T + lambda I) J_i = sum_k du_k dy_ik + lambda J0_i.
   std::vector<std::vector<double>> A(kNu, std::vector<double>(kNu, 0.0));
   for (size_t k = 0; k + 1 < pts.size(); ++k)
@@ -43,7 +44,7 @@ Mat4 estimate_jacobian(const std::vector<ModelPoint>& pts, const Mat4& prior, do
       for (size_t b = 0; b < kNu; ++b)
         A[a][b] += (pts[k].u[a] - last.u[a]) * (pts[k].u[b] - last.u[b]);
   for (size_t a = 0; a < kNu; ++a) A[a][a] += lambda;
-  for (size_t i = 0; i < kNy; ++i) {
+  for (size_t i = 0; i < Ny; ++i) {
     std::vector<double> rhs(kNu, 0.0), row;
     for (size_t a = 0; a < kNu; ++a) {
       for (size_t k = 0; k + 1 < pts.size(); ++k)
@@ -56,14 +57,16 @@ Mat4 estimate_jacobian(const std::vector<ModelPoint>& pts, const Mat4& prior, do
   return J;
 }
 
-Vec4 predict(const Mat4& J, const Vec4& du) {
-  Vec4 dy{};
-  for (size_t i = 0; i < kNy; ++i)
+template <size_t Ny>
+VecN<Ny> predict(const MatN<Ny>& J, const Vec4& du) {
+  VecN<Ny> dy{};
+  for (size_t i = 0; i < Ny; ++i)
     for (size_t m = 0; m < kNu; ++m) dy[i] += J[i][m] * du[m];
   return dy;
 }
 
-Vec4 damped_step(const Mat4& J, const Vec4& e, const Vec4& u, const StepRule& rule) {
+template <size_t Ny>
+Vec4 damped_step(const MatN<Ny>& J, const VecN<Ny>& e, const Vec4& u, const StepRuleN<Ny>& rule) {
   Vec4 du{};
   std::array<bool, kNu> fixed{};
   for (size_t m = 0; m < kNu; ++m) {
@@ -77,8 +80,8 @@ Vec4 damped_step(const Mat4& J, const Vec4& e, const Vec4& u, const StepRule& ru
     for (size_t m = 0; m < kNu; ++m)
       if (!fixed[m]) idx.push_back(m);
     if (idx.empty()) break;
-    Vec4 r = e;
-    for (size_t i = 0; i < kNy; ++i)
+    VecN<Ny> r = e;
+    for (size_t i = 0; i < Ny; ++i)
       for (size_t m = 0; m < kNu; ++m)
         if (fixed[m]) r[i] -= J[i][m] * du[m];
     const size_t n = idx.size();
@@ -86,10 +89,10 @@ Vec4 damped_step(const Mat4& J, const Vec4& e, const Vec4& u, const StepRule& ru
     std::vector<double> b(n, 0.0), x;
     for (size_t a = 0; a < n; ++a) {
       for (size_t c = 0; c < n; ++c)
-        for (size_t i = 0; i < kNy; ++i)
+        for (size_t i = 0; i < Ny; ++i)
           A[a][c] += rule.weight[i] * rule.weight[i] * J[i][idx[a]] * J[i][idx[c]];
       A[a][a] += rule.mu * rule.scale[idx[a]] * rule.scale[idx[a]];
-      for (size_t i = 0; i < kNy; ++i)
+      for (size_t i = 0; i < Ny; ++i)
         b[a] += rule.weight[i] * rule.weight[i] * J[i][idx[a]] * r[i];
     }
     if (!solve_small(A, b, x)) break;
@@ -123,5 +126,15 @@ Vec4 damped_step(const Mat4& J, const Vec4& e, const Vec4& u, const StepRule& ru
                          std::min(rule.max_step[m], rule.upper[m] - u[m]));
   return du;
 }
+
+// The fit's two models: the four macro targets, and those with the toughness.
+template MatN<4> estimate_jacobian<4>(const std::vector<ModelPointN<4>>&, const MatN<4>&, double,
+                                      const MatN<4>&, const MatN<4>&);
+template MatN<5> estimate_jacobian<5>(const std::vector<ModelPointN<5>>&, const MatN<5>&, double,
+                                      const MatN<5>&, const MatN<5>&);
+template VecN<4> predict<4>(const MatN<4>&, const Vec4&);
+template VecN<5> predict<5>(const MatN<5>&, const Vec4&);
+template Vec4 damped_step<4>(const MatN<4>&, const VecN<4>&, const Vec4&, const StepRuleN<4>&);
+template Vec4 damped_step<5>(const MatN<5>&, const VecN<5>&, const Vec4&, const StepRuleN<5>&);
 
 }  // namespace mill::calibrate

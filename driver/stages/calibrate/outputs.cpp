@@ -21,11 +21,14 @@ namespace fs = std::filesystem;
 namespace {
 
 // The macro properties an iteration achieved, with the ore card's key names.
+// (K_IC when the iteration ran the bend test of the toughness fit.)
 nlohmann::json macro(const Iteration& it) {
-  return nlohmann::json{{"youngs_modulus", it.ucs.r.youngs_modulus},
-                        {"poisson_ratio", it.ucs.r.poisson_ratio},
-                        {"ucs", it.ucs.r.ucs},
-                        {"tensile_strength", it.br.r.tensile_strength}};
+  nlohmann::json m{{"youngs_modulus", it.ucs.r.youngs_modulus},
+                   {"poisson_ratio", it.ucs.r.poisson_ratio},
+                   {"ucs", it.ucs.r.ucs},
+                   {"tensile_strength", it.br.r.tensile_strength}};
+  if (it.scb) m["fracture_toughness"] = it.scb->r.toughness;
+  return m;
 }
 
 // A value of a run's info line, 0 when the deck did not write it.
@@ -117,6 +120,20 @@ std::vector<std::string> Report::explain_missed() const {
   if (b_.err_t > tol_)
     missed.push_back(fmt::format("tensile strength {:.2f} MPa is {:.0f}% off the target",
                                  b_.br.r.tensile_strength / 1e6, 100 * b_.err_t));
+  if (t_.toughness > 0 && b_.err_kic > tol_) {
+    // K_IC follows the bond tensile strength (the notch opens in tension);
+    // the Brazilian strength follows it and the cohesion together, so K_IC
+    // and T pull sigma_b apart at a given element size.
+    missed.push_back(fmt::format(
+        "K_IC {:.3f} MPa m^0.5 is {:.0f}% off the target {:.3f}: it follows the bond tensile "
+        "strength (now {:.2f} MPa, cohesion {:.2f} MPa), which the tensile strength and the UCS "
+        "pull too; at this element size (mean radius {:.2f} mm) the card's K_IC/tensile ratio of "
+        "{:.3f} m^0.5 needs another sigma_b than its tensile strength does (docs/calibration.md, "
+        "\"The toughness as a target\")",
+        b_.scb ? b_.scb->r.toughness / 1e6 : 0.0, 100 * b_.err_kic, t_.toughness / 1e6,
+        b_.p.tensile / 1e6, b_.p.cohesion / 1e6, sp_.mean_radius * 1e3,
+        t_.toughness / t_.tensile));
+  }
   if (b_.err_ucs > tol_) {
     const double ratio = b_.ucs.r.ucs / b_.br.r.tensile_strength, want = t_.ucs / t_.tensile;
     // Measured sensitivity of the UCS to the cohesion ratio (last two iterations that moved it).
@@ -180,10 +197,14 @@ nlohmann::json Report::json() const {
          {"bond", bond_json(it.p, BondNames::report)},
          {"achieved", macro(it)},
          {"errors",
-          {{"youngs_modulus", it.err_E},
-           {"poisson_ratio", it.err_nu},
-           {"ucs", it.err_ucs},
-           {"tensile_strength", it.err_t}}},
+          [&] {
+            nlohmann::json e{{"youngs_modulus", it.err_E},
+                             {"poisson_ratio", it.err_nu},
+                             {"ucs", it.err_ucs},
+                             {"tensile_strength", it.err_t}};
+            if (t_.toughness > 0) e["fracture_toughness"] = it.err_kic;
+            return e;
+          }()},
          {"within_tolerance", it.converged},
          {"ucs_fit_window_Pa", {it.ucs.r.fit_stress_lo, it.ucs.r.fit_stress_hi}},
          {"ucs_fit_r2", it.ucs.r.fit.r2},
@@ -191,9 +212,15 @@ nlohmann::json Report::json() const {
          {"brazilian_peak_force_N", it.br.r.peak_force},
          {"ucs_peaked", it.ucs.peaked},
          {"brazilian_peaked", it.br.peaked},
+         {"scb_peak_force_N", it.scb ? nlohmann::json(it.scb->r.peak_force) : nlohmann::json()},
          {"energy",
-          {{"ucs", lab_energy_json(it.ucs.energy)}, {"brazilian", lab_energy_json(it.br.energy)}}},
-         {"wall_seconds", it.ucs.seconds + it.br.seconds}});
+          it.scb ? nlohmann::json{{"ucs", lab_energy_json(it.ucs.energy)},
+                                  {"brazilian", lab_energy_json(it.br.energy)},
+                                  {"scb", lab_energy_json(it.scb->energy)}}
+                 : nlohmann::json{{"ucs", lab_energy_json(it.ucs.energy)},
+                                  {"brazilian", lab_energy_json(it.br.energy)}}},
+         {"wall_seconds", it.ucs.seconds + it.br.seconds + (it.scb ? it.scb->seconds : 0.0)}});
+    if (!it.scb) iters.back().erase("scb_peak_force_N");
   }
   nlohmann::json specimen = {{"seed", d_.integer("calibrate.seed")},
                              {"ball_elements", sp_.ball_elements},
@@ -220,6 +247,10 @@ nlohmann::json Report::json() const {
                            {"poisson_ratio", b_.err_nu <= kNuTolerance},
                            {"ucs", b_.err_ucs <= tol_},
                            {"tensile_strength", b_.err_t <= tol_}};
+  if (t_.toughness > 0) {
+    targets["fracture_toughness"] = t_.toughness;
+    within["fracture_toughness"] = b_.err_kic <= tol_;
+  }
   nlohmann::json report = {
       {"ore", ore_.str("name")},
       {"input_hash", hash_},
@@ -269,11 +300,14 @@ std::string Report::yaml() const {
   y << YAML::Key << "youngs_modulus" << YAML::Value << t_.E << YAML::Key << "poisson_ratio"
     << YAML::Value << t_.nu << YAML::Key << "ucs" << YAML::Value << t_.ucs << YAML::Key
     << "tensile_strength" << YAML::Value << t_.tensile;
+  if (t_.toughness > 0) y << YAML::Key << "fracture_toughness" << YAML::Value << t_.toughness;
   y << YAML::EndMap;
   y << YAML::Key << "achieved" << YAML::Value << YAML::BeginMap;
   y << YAML::Key << "youngs_modulus" << YAML::Value << b_.ucs.r.youngs_modulus << YAML::Key
     << "poisson_ratio" << YAML::Value << b_.ucs.r.poisson_ratio << YAML::Key << "ucs" << YAML::Value
     << b_.ucs.r.ucs << YAML::Key << "tensile_strength" << YAML::Value << b_.br.r.tensile_strength;
+  if (b_.scb)
+    y << YAML::Key << "fracture_toughness" << YAML::Value << b_.scb->r.toughness;
   y << YAML::EndMap;
   y << YAML::Key << "specimen" << YAML::Value << YAML::BeginMap;
   y << YAML::Key << "elements" << YAML::Value << n_;
@@ -306,9 +340,15 @@ std::string Report::markdown() const {
   md << fmt::format("| UCS (MPa) | {:.1f} | {:.1f} | {:.1f}% | {:.0f}% | {} |\n", t_.ucs / 1e6,
                     b_.ucs.r.ucs / 1e6, 100 * b_.err_ucs, 100 * tol_,
                     b_.err_ucs <= tol_ ? "yes" : "no");
-  md << fmt::format("| tensile (MPa) | {:.2f} | {:.2f} | {:.1f}% | {:.0f}% | {} |\n\n",
+  md << fmt::format("| tensile (MPa) | {:.2f} | {:.2f} | {:.1f}% | {:.0f}% | {} |\n",
                     t_.tensile / 1e6, b_.br.r.tensile_strength / 1e6, 100 * b_.err_t, 100 * tol_,
                     b_.err_t <= tol_ ? "yes" : "no");
+  if (t_.toughness > 0 && b_.scb)
+    md << fmt::format("| K_IC (MPa m^0.5; semi-circular bend) | {:.3f} | {:.3f} | {:.1f}% | {:.0f}% | "
+                      "{} |\n",
+                      t_.toughness / 1e6, b_.scb->r.toughness / 1e6, 100 * b_.err_kic, 100 * tol_,
+                      b_.err_kic <= tol_ ? "yes" : "no");
+  md << "\n";
   md << "## Bond parameters (calibrated.yaml)\n\n| parameter | value |\n|---|---|\n";
   md << fmt::format(
       "| bond model (lump.bond_model) | {} |\n| bond modulus (GPa) | {:.3f} |\n| kn/ks | {:.3f} "
@@ -320,18 +360,26 @@ std::string Report::markdown() const {
       b_.p.model == BondModel::parallel ? fmt::format("| moment factor | {:g} |\n", b_.p.moment_factor)
                                         : std::string(),
       b_.p.radius_multiplier);
-  md << "## Iterations\n\n| it | E_b (GPa) | kn/ks | sigma_b (MPa) | c (MPa) | phi (deg) | beta | "
-        "E (GPa) | nu | UCS (MPa) | tensile (MPa) | UCS/tensile | "
-        "wall (s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  // The toughness fit adds a K_IC column.
+  const bool kic = t_.toughness > 0;
+  md << fmt::format(
+      "## Iterations\n\n| it | E_b (GPa) | kn/ks | sigma_b (MPa) | c (MPa) | phi (deg) | beta | "
+      "E (GPa) | nu | UCS (MPa) | tensile (MPa) | UCS/tensile | {}"
+      "wall (s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|{}---|\n",
+      kic ? "K_IC (MPa m^0.5) | " : "", kic ? "---|" : "");
   for (size_t i = 0; i < hist_.size(); ++i) {
     const auto& it = hist_[i];
     md << fmt::format(
         "| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.0f} | {:g} | {:.2f} | {:.3f} | {:.2f} | "
-        "{:.2f} | {:.2f} | {:.0f} |\n",
+        "{:.2f} | {:.2f} | {}{:.0f} |\n",
         i + 1, it.p.modulus / 1e9, it.p.stiffness_ratio, it.p.tensile / 1e6, it.p.cohesion / 1e6,
         it.p.friction_angle_deg, it.p.moment_factor, it.ucs.r.youngs_modulus / 1e9,
         it.ucs.r.poisson_ratio, it.ucs.r.ucs / 1e6, it.br.r.tensile_strength / 1e6,
-        it.ucs.r.ucs / it.br.r.tensile_strength, it.ucs.seconds + it.br.seconds);
+        it.ucs.r.ucs / it.br.r.tensile_strength,
+        !kic      ? std::string()
+        : it.scb ? fmt::format("{:.3f} | ", it.scb->r.toughness / 1e6)
+                 : std::string("- | "),
+        it.ucs.seconds + it.br.seconds + (it.scb ? it.scb->seconds : 0.0));
   }
   if (half_)
     md << fmt::format(
