@@ -5,6 +5,7 @@ E = secant modulus at half the peak (gauge length from ucs_info.txt);
 K_IC of the semi-circular bend test when it ran (Kuruppu et al. 2014,
 eqs. 1-2, as post::ScbToughness)."""
 import math
+import os
 import sys
 
 
@@ -23,6 +24,9 @@ def curve(path):
 
 
 def analyse(out, model):
+    """UCS, T, E, peaked and K_IC; None for a test that did not run."""
+    if not os.path.exists(f"{out}/{model}/ucs/ucs_info.txt"):
+        return None, None, None, None, toughness(out, model)
     ui = info(f"{out}/{model}/ucs/ucs_info.txt")
     uc = curve(f"{out}/{model}/ucs/ucs_curve.txt")
     d = float(ui["diameter"])
@@ -66,6 +70,9 @@ def main():
     for m in models:
         ucs, t, e, peaked, k = analyse(out, m)
         kic = "-" if k is None else f"{k / 1e6:.3f}"
+        if ucs is None:
+            print(f"| {m} | - | - | - | - | - | {kic} |")
+            continue
         print(f"| {m} | {ucs / 1e6:.1f} | {t / 1e6:.2f} | {ucs / t:.2f} | {e / 1e9:.1f} | "
               f"{'yes' if peaked else 'no (cap reached)'} | {kic} |")
 

@@ -549,7 +549,8 @@ Schema make_ore_schema() {
                     1, 50, "a rock's Hoek-Brown m_i", kHoekBrownMiSource)),
       opt(plausible(positive(key("fracture_toughness", T::Real, "Pa m^0.5", "",
                                  "Mode-I fracture toughness K_IC; given, the calibration runs a semi-circular bend "
-                                 "test (Kuruppu et al. 2014) and reports its K_IC against it (a check, not fitted)")),
+                                 "test (Kuruppu et al. 2014) and reports its K_IC against it; with flat joints it is also a "
+                                 "target of the fit (calibrate.fit_toughness), with the parallel bond a check only")),
                     2e4, 1e7, "a rock's mode-I fracture toughness", kToughnessSource,
                     {{"kPa m^0.5", 1e3}, {"MPa m^0.5", 1e6}})),
       // Measured JK drop-weight parameters (Napier-Munn et al. 1996), optional:

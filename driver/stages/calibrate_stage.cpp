@@ -230,6 +230,7 @@ void Calibration::run() {
     o.checks = run_checks(lab, hist[o.best].p, hist[o.best].ucs, rate_,
                           confining_pressures(d_, hist[o.best].ucs.r.ucs), check_for,
                           (per_it * max_it_ + 2.0 + n_sensitivity) / steps_total, 1.0 / steps_total);
+  o.checks.toughness_fitted = fit_.fits_toughness();
   o.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_outputs(ctx_, dir_, fit_, o);
 }

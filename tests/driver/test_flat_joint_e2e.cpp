@@ -3,8 +3,11 @@
 // (liggghts_inputs/lump_bonds.in: bond/${bond_style} with the model's
 // ${bond_model_keys}), records the model in every job's result, conserves
 // energy in the ledger, and breaks more at the faster impact.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <string>
@@ -55,4 +58,72 @@ TEST(FlatJointBreakage, ImpactsRunWithFlatJointsAndConserveEnergy) {
   EXPECT_GE(broken[0], 0.0);
   EXPECT_GT(broken[1], broken[0]) << "80 m/s must break more interfaces than 5 m/s";
   fs::remove_all(dir);
+}
+
+// The toughness as a target of the flat joint's fit (calibrate.fit_toughness,
+// docs/calibration.md, "The toughness as a target"): a tiny flat-joint
+// calibration of the sandstone card (K_IC 0.73 MPa m^0.5) runs the
+// semi-circular bend test in every iteration, each with its energy ledger,
+// and reports K_IC as a target beside E, nu, UCS and T. The same case with
+// the key off is another job, whose iterations run no bend test.
+TEST(FlatJointCalibration, ToughnessIsATargetOfTheFit) {
+  const fs::path dir = scratch("flat_joint_kic");
+  const std::string base =
+      "ore: {card: sandstone}\n"
+      "lump: {n_elements: 150, diameter: 0.02, bond_model: flat_joint, bond_gap: 1.0, "
+      "max_bonds: 32}\n"
+      "resources: {np: 1, jobs: 1}\n";
+  // 400-element specimens: the half disc of 200 has no element under its
+  // load point (the stage stops on it: ScbTooCoarse).
+  const std::string cal =
+      "calibrate: {n_elements: 400, strain_rate: 2.0, seed: 2003, rate_check: false, "
+      "sensitivity: false, confining_pressures: [0.1]";
+  spit(dir / "on.yaml", "name: kic_on\n" + base + cal + ", max_iterations: 2}\n");
+  spit(dir / "off.yaml",
+       "name: kic_off\n" + base + cal + ", max_iterations: 1, fit_toughness: false}\n");
+  const fs::path run = dir / "run";
+  ASSERT_EQ(orchestrate("--case " + (dir / "on.yaml").string() + " --stage calibrate --output " +
+                            run.string(),
+                        dir / "on.log"),
+            0)
+      << slurp(dir / "on.log");
+  const fs::path job = run / "calibrate" / "jobs" / "calibration";
+  const auto r = nlohmann::json::parse(slurp(job / "report.json"));
+  EXPECT_DOUBLE_EQ(r["targets"]["fracture_toughness"].get<double>(), 0.73e6) << r["targets"];
+  ASSERT_TRUE(r["within_tolerance"].contains("fracture_toughness")) << r["within_tolerance"];
+  const auto& its = r["iterations"];
+  ASSERT_GE(its.size(), 1u);
+  for (size_t k = 0; k < its.size(); ++k) {
+    const auto& it = its[k];
+    const double kic = it["achieved"].value("fracture_toughness", -1.0);
+    EXPECT_TRUE(std::isfinite(kic) && kic > 1e4 && kic < 1e8) << "iteration " << k + 1 << ": " << kic;
+    EXPECT_NEAR(it["errors"]["fracture_toughness"].get<double>(), std::abs(kic / 0.73e6 - 1.0),
+                1e-9);
+    // Every bend test's energy ledger closes (the decks stop past 1 %).
+    EXPECT_LT(std::abs(it["energy"]["scb"].value("residual_fraction_max", 1.0)), 0.01) << k;
+    EXPECT_TRUE(fs::exists(job / "runs" / fmt::format("it{}_scb", k + 1) / "ledger.csv")) << k;
+  }
+  EXPECT_TRUE(r["checks"].value("toughness_fitted", false));
+  const std::string md = slurp(job / "report.md");
+  EXPECT_NE(md.find("| K_IC (MPa m^0.5; semi-circular bend) | 0.730 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("K_IC (MPa m^0.5) | wall (s) |"), std::string::npos) << md;
+  const YAML::Node y = YAML::LoadFile((run / "calibrate" / "calibrated.yaml").string());
+  EXPECT_DOUBLE_EQ(y["targets"]["fracture_toughness"].as<double>(), 0.73e6);
+  EXPECT_GT(y["achieved"]["fracture_toughness"].as<double>(), 0.0);
+
+  // The key off: another job id (the fit differs), no bend test per iteration.
+  const fs::path run_off = dir / "run_off";
+  ASSERT_EQ(orchestrate("--case " + (dir / "off.yaml").string() + " --stage calibrate --output " +
+                            run_off.string(),
+                        dir / "off.log"),
+            0)
+      << slurp(dir / "off.log");
+  const fs::path job_off = run_off / "calibrate" / "jobs" / "calibration";
+  EXPECT_FALSE(fs::exists(job_off / "runs" / "it1_scb"));
+  EXPECT_TRUE(fs::exists(job_off / "runs" / "scb"));  // the check after the fit
+  const auto r_off = nlohmann::json::parse(slurp(job_off / "report.json"));
+  EXPECT_FALSE(r_off["targets"].contains("fracture_toughness"));
+  EXPECT_NE(nlohmann::json::parse(slurp(job / "job.json")).value("id", std::string("a")),
+            nlohmann::json::parse(slurp(job_off / "job.json")).value("id", std::string("b")));
+  if (!HasFailure()) fs::remove_all(dir);
 }

@@ -33,6 +33,7 @@ struct Checks {
   std::string envelope_error;           // why an envelope could not be fitted, else ""
   std::optional<ScbRun> scb;            // only when the card gives fracture_toughness
   std::vector<std::string> notes;       // what limits the checks' meaning, in words
+  bool toughness_fitted = false;        // K_IC was a target of the fit (calibrate.fit_toughness)
 };
 
 // The confining pressures [Pa] of the checks: calibrate.confining_pressures

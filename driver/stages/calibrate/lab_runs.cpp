@@ -150,6 +150,19 @@ ScbRun LabBench::scb(const BondParams& p, double rate, const RunStep& step) {
   ScbRun s;
   const fs::path work =
       run_test({"scb", sp_.disc_r, 4.0 * t_.tensile / t_.E, 10.0}, p, rate, step, s);
+  // A half disc too coarse for the three-point bend has no element under
+  // the load point or over a support: its "peak" would be noise. Measured:
+  // 200-element specimens (56 elements in the half disc) leave the load
+  // point empty; 400 give 2 and 6.
+  for (const char* layer : {"load_layer", "support_layer"})
+    if (info_at(s.info, layer, s.info_file) < 1)
+      throw ScbTooCoarse(fmt::format(
+          "{}: the semi-circular bend specimen ({:g} elements) has no element in its {} "
+          "(load_layer {:g}, support_layer {:g}): calibrate.n_elements is too few for the "
+          "toughness test; use at least 400, or drop fracture_toughness from the ore card",
+          s.info_file.string(), info_at(s.info, "atoms", s.info_file), layer,
+          info_at(s.info, "load_layer", s.info_file),
+          info_at(s.info, "support_layer", s.info_file)));
   s.curve = post::ReadLoadCurve((work / "scb_curve.txt").string());
   s.r = post::AnalyseScb(
       s.curve, info_at(s.info, "radius", s.info_file), info_at(s.info, "thickness", s.info_file),

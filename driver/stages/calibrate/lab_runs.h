@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -57,6 +58,12 @@ struct TriaxialRun : LabRun {
 
 struct ScbRun : LabRun {
   post::ScbResult r;
+};
+
+// A semi-circular bend specimen too coarse for the test (no element under
+// the load point or over a support).
+struct ScbTooCoarse : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 // One run of a lab test: its folder <dir>/runs/<tag>, what the progress line
