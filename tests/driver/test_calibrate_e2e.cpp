@@ -89,8 +89,7 @@ TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
       {"sens_bond_moment_factor_brazilian",
        r["sensitivity"]["levers"]["bond_moment_factor"]["energy"]["brazilian"]},
       {"triaxial_1", r["checks"]["triaxial"][0]["energy"]},
-      {"triaxial_2", r["checks"]["triaxial"][1]["energy"]},
-      {"scb", r["checks"]["scb"]["energy"]}};
+      {"triaxial_2", r["checks"]["triaxial"][1]["energy"]}};
   for (const auto& [run, e] : runs) {
     ASSERT_TRUE(e.is_object()) << run << ": " << r.dump(2);
     for (const char* k :
@@ -103,8 +102,9 @@ TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
     EXPECT_GE(e["bond_released_J"].get<double>(), 0.0) << run << ": " << e.dump();
   }
   const auto& worst = r["energy"];
-  // 2 (iteration) + 1 (rate check) + 12 (6 levers) + 3 (checks).
-  EXPECT_EQ(worst["lab_runs"].get<int>(), 18) << worst.dump();
+  // 2 (iteration) + 1 (rate check) + 12 (6 levers) + 2 (triaxial checks;
+  // the bend test's half disc is too coarse here: not measured, below).
+  EXPECT_EQ(worst["lab_runs"].get<int>(), 17) << worst.dump();
   EXPECT_LT(worst["worst_residual_fraction_max"].get<double>(), 0.01) << worst.dump();
   const std::string worst_run = worst["worst_run"].get<std::string>();
   EXPECT_TRUE(std::any_of(runs.begin(), runs.end(), [&](const auto& run) {
@@ -114,7 +114,7 @@ TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
   EXPECT_NE(md.find("## Energy ledger"), std::string::npos) << md;
   for (const char* row : {"| it1_ucs * |", "| it1_brazilian * |", "| rate_check_ucs |",
                           "| sens_bond_modulus_ucs |", "| sens_bond_cohesion_brazilian |",
-                          "| triaxial_1 |", "| triaxial_2 |", "| scb |"})
+                          "| triaxial_1 |", "| triaxial_2 |"})
     EXPECT_NE(md.find(row), std::string::npos) << row << " in\n" << md;
   EXPECT_NE(md.find("Largest residual of any lab run: "), std::string::npos) << md;
 
@@ -158,10 +158,16 @@ TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
   EXPECT_DOUBLE_EQ(vs["friction_angle"]["target"].get<double>(), 47.0) << vs.dump(2);
   EXPECT_DOUBLE_EQ(vs["hoek_brown_mi"]["target"].get<double>(), 17.0) << vs.dump(2);
   EXPECT_DOUBLE_EQ(vs["fracture_toughness"]["target"].get<double>(), 0.73e6) << vs.dump(2);
-  ASSERT_TRUE(ck["scb"].is_object()) << ck.dump(2);
-  EXPECT_GT(ck["scb"]["fracture_toughness_Pa_m0.5"].get<double>(), 0.0) << ck.dump(2);
-  EXPECT_DOUBLE_EQ(vs["fracture_toughness"]["achieved"].get<double>(),
-                   ck["scb"]["fracture_toughness_Pa_m0.5"].get<double>());
+  // The 200-element specimens' half disc (58 elements) has no element under
+  // its load point: the check says so and gives no K_IC (a figure from it
+  // would be the support's noise). e2e.flat_joint_toughness measures K_IC
+  // on 400-element specimens.
+  EXPECT_TRUE(ck["scb"].is_null()) << ck.dump(2);
+  EXPECT_TRUE(vs["fracture_toughness"]["achieved"].is_null()) << vs.dump(2);
+  bool named = false;
+  for (const auto& n : ck["notes"])
+    named = named || n.get<std::string>().find("scb: not measured") != std::string::npos;
+  EXPECT_TRUE(named) << ck["notes"].dump(2);
   EXPECT_NE(md.find("## Checks after the fit (not a lever yet)"), std::string::npos) << md;
   EXPECT_NE(md.find("| friction angle (deg) | 47.0 |"), std::string::npos) << md;
 

@@ -104,6 +104,13 @@ TEST(FlatJointCalibration, ToughnessIsATargetOfTheFit) {
     EXPECT_TRUE(fs::exists(job / "runs" / fmt::format("it{}_scb", k + 1) / "ledger.csv")) << k;
   }
   EXPECT_TRUE(r["checks"].value("toughness_fitted", false));
+  // The check after the fit repeats the result's bend test: the same K_IC.
+  const auto& ck = r["checks"];
+  ASSERT_TRUE(ck["scb"].is_object()) << ck.dump(2);
+  const double kic_check = ck["scb"]["fracture_toughness_Pa_m0.5"].get<double>();
+  EXPECT_NEAR(kic_check, r["achieved"]["fracture_toughness"].get<double>(), 1e-6 * kic_check);
+  EXPECT_DOUBLE_EQ(ck["against_card"]["fracture_toughness"]["achieved"].get<double>(), kic_check);
+  EXPECT_LT(std::abs(ck["scb"]["energy"].value("residual_fraction_max", 1.0)), 0.01);
   const std::string md = slurp(job / "report.md");
   EXPECT_NE(md.find("| K_IC (MPa m^0.5; semi-circular bend) | 0.730 |"), std::string::npos) << md;
   EXPECT_NE(md.find("K_IC (MPa m^0.5) | wall (s) |"), std::string::npos) << md;
