@@ -116,13 +116,17 @@ def plot_brazilian(runs, report, out):
 
 
 def plot_convergence(report, out):
-    """Achieved / target of each property per iteration, with the tolerance band."""
+    """Achieved / target of each property per iteration, with the tolerance band
+    (K_IC too when the fit aimed at it: calibrate.fit_toughness)."""
     t = report["targets"]
     tol = report["tolerance"]["relative"]
     its = [i["iteration"] for i in report["iterations"]]
     fig, ax = plt.subplots(figsize=(7, 4))
-    for key, name in (("youngs_modulus", "E"), ("poisson_ratio", "nu"), ("ucs", "UCS"),
-                      ("tensile_strength", "tensile")):
+    props = [("youngs_modulus", "E"), ("poisson_ratio", "nu"), ("ucs", "UCS"),
+             ("tensile_strength", "tensile")]
+    if "fracture_toughness" in t:
+        props.append(("fracture_toughness", "K_IC"))
+    for key, name in props:
         ax.plot(its, [i["achieved"][key] / t[key] for i in report["iterations"]], "o-", label=name)
     ax.axhspan(1 - tol, 1 + tol, color="green", alpha=0.15, label=f"+-{100 * tol:.0f}%")
     ax.set_xlabel("iteration")
