@@ -162,8 +162,7 @@ void Calibration::run() {
   const double n_sensitivity =
       sensitivity ? 2.0 * static_cast<double>(sensitivity_levers(p).size()) : 0.0;
   const double per_it = fit_.fits_toughness() ? 3.0 : 2.0;
-  const double steps_total =
-      per_it * max_it_ + (rate_check ? 2.0 : 0.0) + n_sensitivity + n_checks;
+  const double steps_total = per_it * max_it_ + (rate_check ? 2.0 : 0.0) + n_sensitivity + n_checks;
   for (int k = 1; k <= max_it_; ++k) {
     Iteration it;
     it.p = p;
@@ -207,14 +206,13 @@ void Calibration::run() {
   o.best = fit_.best(hist);
   // Rate check: the best parameters at half the strain rate.
   if (rate_check)
-    o.half = lab.ucs(
-        hist[o.best].p, 0.5 * rate_,
-        {"rate_check_ucs", "rate check: UCS at half the strain rate", per_it * max_it_ / steps_total});
+    o.half = lab.ucs(hist[o.best].p, 0.5 * rate_,
+                     {"rate_check_ucs", "rate check: UCS at half the strain rate",
+                      per_it * max_it_ / steps_total});
   // Sensitivities: each lever stepped alone from the best parameters.
   if (sensitivity) {
-    o.sensitivity =
-        run_sensitivity(lab, hist[o.best].p, rate_, (per_it * max_it_ + 2.0) / steps_total,
-                        1.0 / steps_total);
+    o.sensitivity = run_sensitivity(lab, hist[o.best].p, rate_,
+                                    (per_it * max_it_ + 2.0) / steps_total, 1.0 / steps_total);
     const Noise noise = sensitivity_noise(hist[o.best].ucs, o.half ? &*o.half : nullptr);
     for (const LeverRun& run : o.sensitivity) {
       const LeverSensitivity s = lever_sensitivity(hist[o.best], run);
@@ -227,9 +225,10 @@ void Calibration::run() {
     }
   }
   if (primary)
-    o.checks = run_checks(lab, hist[o.best].p, hist[o.best].ucs, rate_,
-                          confining_pressures(d_, hist[o.best].ucs.r.ucs), check_for,
-                          (per_it * max_it_ + 2.0 + n_sensitivity) / steps_total, 1.0 / steps_total);
+    o.checks =
+        run_checks(lab, hist[o.best].p, hist[o.best].ucs, rate_,
+                   confining_pressures(d_, hist[o.best].ucs.r.ucs), check_for,
+                   (per_it * max_it_ + 2.0 + n_sensitivity) / steps_total, 1.0 / steps_total);
   o.checks.toughness_fitted = fit_.fits_toughness();
   o.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_outputs(ctx_, dir_, fit_, o);

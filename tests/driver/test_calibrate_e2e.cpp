@@ -112,9 +112,9 @@ TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
   })) << worst_run;
   const std::string md = slurp(*dir_ / "calibrate" / "report.md");
   EXPECT_NE(md.find("## Energy ledger"), std::string::npos) << md;
-  for (const char* row : {"| it1_ucs * |", "| it1_brazilian * |", "| rate_check_ucs |",
-                          "| sens_bond_modulus_ucs |", "| sens_bond_cohesion_brazilian |",
-                          "| triaxial_1 |", "| triaxial_2 |"})
+  for (const char* row :
+       {"| it1_ucs * |", "| it1_brazilian * |", "| rate_check_ucs |", "| sens_bond_modulus_ucs |",
+        "| sens_bond_cohesion_brazilian |", "| triaxial_1 |", "| triaxial_2 |"})
     EXPECT_NE(md.find(row), std::string::npos) << row << " in\n" << md;
   EXPECT_NE(md.find("Largest residual of any lab run: "), std::string::npos) << md;
 

@@ -96,7 +96,8 @@ TEST(FlatJointCalibration, ToughnessIsATargetOfTheFit) {
   for (size_t k = 0; k < its.size(); ++k) {
     const auto& it = its[k];
     const double kic = it["achieved"].value("fracture_toughness", -1.0);
-    EXPECT_TRUE(std::isfinite(kic) && kic > 1e4 && kic < 1e8) << "iteration " << k + 1 << ": " << kic;
+    EXPECT_TRUE(std::isfinite(kic) && kic > 1e4 && kic < 1e8)
+        << "iteration " << k + 1 << ": " << kic;
     EXPECT_NEAR(it["errors"]["fracture_toughness"].get<double>(), std::abs(kic / 0.73e6 - 1.0),
                 1e-9);
     // Every bend test's energy ledger closes (the decks stop past 1 %).

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "lump/material.h"
-#include "stages/calibrate/local_model.h"
 #include "stages/calibrate/lab_runs.h"
+#include "stages/calibrate/local_model.h"
 
 namespace mill::calibrate {
 

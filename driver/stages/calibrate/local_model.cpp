@@ -92,8 +92,7 @@ Vec4 damped_step(const MatN<Ny>& J, const VecN<Ny>& e, const Vec4& u, const Step
         for (size_t i = 0; i < Ny; ++i)
           A[a][c] += rule.weight[i] * rule.weight[i] * J[i][idx[a]] * J[i][idx[c]];
       A[a][a] += rule.mu * rule.scale[idx[a]] * rule.scale[idx[a]];
-      for (size_t i = 0; i < Ny; ++i)
-        b[a] += rule.weight[i] * rule.weight[i] * J[i][idx[a]] * r[i];
+      for (size_t i = 0; i < Ny; ++i) b[a] += rule.weight[i] * rule.weight[i] * J[i][idx[a]] * r[i];
     }
     if (!solve_small(A, b, x)) break;
     // The component farthest past its limits (as a share of its step) is

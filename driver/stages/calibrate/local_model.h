@@ -51,10 +51,11 @@ MatN<Ny> estimate_jacobian(const std::vector<ModelPointN<Ny>>& pts, const MatN<N
 // Settings of one step.
 template <size_t Ny>
 struct StepRuleN {
-  VecN<Ny> weight{};      // per response: 1 / its tolerance (errors in tolerance units; 0: not a target)
-  double mu = 0.1;        // Levenberg-Marquardt damping
-  Vec4 scale{};           // per parameter: its prior slope on its own target, weighted
-  Vec4 max_step{};        // |du_m| at most this (a trust region per parameter)
+  VecN<Ny>
+      weight{};     // per response: 1 / its tolerance (errors in tolerance units; 0: not a target)
+  double mu = 0.1;  // Levenberg-Marquardt damping
+  Vec4 scale{};     // per parameter: its prior slope on its own target, weighted
+  Vec4 max_step{};  // |du_m| at most this (a trust region per parameter)
   Vec4 lower{}, upper{};  // bounds of u_m + du_m
   Vec4 free{1, 1, 1, 1};  // 0: the parameter takes its held value this step
   Vec4 held{};            // the step of a parameter that is not free

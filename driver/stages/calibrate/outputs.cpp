@@ -131,8 +131,7 @@ std::vector<std::string> Report::explain_missed() const {
         "{:.3f} m^0.5 needs another sigma_b than its tensile strength does (docs/calibration.md, "
         "\"The toughness as a target\")",
         b_.scb ? b_.scb->r.toughness / 1e6 : 0.0, 100 * b_.err_kic, t_.toughness / 1e6,
-        b_.p.tensile / 1e6, b_.p.cohesion / 1e6, sp_.mean_radius * 1e3,
-        t_.toughness / t_.tensile));
+        b_.p.tensile / 1e6, b_.p.cohesion / 1e6, sp_.mean_radius * 1e3, t_.toughness / t_.tensile));
   }
   if (b_.err_ucs > tol_) {
     const double ratio = b_.ucs.r.ucs / b_.br.r.tensile_strength, want = t_.ucs / t_.tensile;
@@ -213,12 +212,11 @@ nlohmann::json Report::json() const {
          {"ucs_peaked", it.ucs.peaked},
          {"brazilian_peaked", it.br.peaked},
          {"scb_peak_force_N", it.scb ? nlohmann::json(it.scb->r.peak_force) : nlohmann::json()},
-         {"energy",
-          it.scb ? nlohmann::json{{"ucs", lab_energy_json(it.ucs.energy)},
-                                  {"brazilian", lab_energy_json(it.br.energy)},
-                                  {"scb", lab_energy_json(it.scb->energy)}}
-                 : nlohmann::json{{"ucs", lab_energy_json(it.ucs.energy)},
-                                  {"brazilian", lab_energy_json(it.br.energy)}}},
+         {"energy", it.scb ? nlohmann::json{{"ucs", lab_energy_json(it.ucs.energy)},
+                                            {"brazilian", lab_energy_json(it.br.energy)},
+                                            {"scb", lab_energy_json(it.scb->energy)}}
+                           : nlohmann::json{{"ucs", lab_energy_json(it.ucs.energy)},
+                                            {"brazilian", lab_energy_json(it.br.energy)}}},
          {"wall_seconds", it.ucs.seconds + it.br.seconds + (it.scb ? it.scb->seconds : 0.0)}});
     if (!it.scb) iters.back().erase("scb_peak_force_N");
   }
@@ -306,8 +304,7 @@ std::string Report::yaml() const {
   y << YAML::Key << "youngs_modulus" << YAML::Value << b_.ucs.r.youngs_modulus << YAML::Key
     << "poisson_ratio" << YAML::Value << b_.ucs.r.poisson_ratio << YAML::Key << "ucs" << YAML::Value
     << b_.ucs.r.ucs << YAML::Key << "tensile_strength" << YAML::Value << b_.br.r.tensile_strength;
-  if (b_.scb)
-    y << YAML::Key << "fracture_toughness" << YAML::Value << b_.scb->r.toughness;
+  if (b_.scb) y << YAML::Key << "fracture_toughness" << YAML::Value << b_.scb->r.toughness;
   y << YAML::EndMap;
   y << YAML::Key << "specimen" << YAML::Value << YAML::BeginMap;
   y << YAML::Key << "elements" << YAML::Value << n_;
@@ -344,10 +341,11 @@ std::string Report::markdown() const {
                     t_.tensile / 1e6, b_.br.r.tensile_strength / 1e6, 100 * b_.err_t, 100 * tol_,
                     b_.err_t <= tol_ ? "yes" : "no");
   if (t_.toughness > 0 && b_.scb)
-    md << fmt::format("| K_IC (MPa m^0.5; semi-circular bend) | {:.3f} | {:.3f} | {:.1f}% | {:.0f}% | "
-                      "{} |\n",
-                      t_.toughness / 1e6, b_.scb->r.toughness / 1e6, 100 * b_.err_kic, 100 * tol_,
-                      b_.err_kic <= tol_ ? "yes" : "no");
+    md << fmt::format(
+        "| K_IC (MPa m^0.5; semi-circular bend) | {:.3f} | {:.3f} | {:.1f}% | {:.0f}% | "
+        "{} |\n",
+        t_.toughness / 1e6, b_.scb->r.toughness / 1e6, 100 * b_.err_kic, 100 * tol_,
+        b_.err_kic <= tol_ ? "yes" : "no");
   md << "\n";
   md << "## Bond parameters (calibrated.yaml)\n\n| parameter | value |\n|---|---|\n";
   md << fmt::format(
@@ -376,7 +374,7 @@ std::string Report::markdown() const {
         it.p.friction_angle_deg, it.p.moment_factor, it.ucs.r.youngs_modulus / 1e9,
         it.ucs.r.poisson_ratio, it.ucs.r.ucs / 1e6, it.br.r.tensile_strength / 1e6,
         it.ucs.r.ucs / it.br.r.tensile_strength,
-        !kic      ? std::string()
+        !kic     ? std::string()
         : it.scb ? fmt::format("{:.3f} | ", it.scb->r.toughness / 1e6)
                  : std::string("- | "),
         it.ucs.seconds + it.br.seconds + (it.scb ? it.scb->seconds : 0.0));
