@@ -145,3 +145,40 @@ TEST(LocalModel, CappedComponentIsFixedAndTheRestResolved) {
   EXPECT_EQ(dw[3], 0.0);
   EXPECT_NEAR(dw[2], std::log(2.0) / 2.0, 1e-12);
 }
+
+// A fifth response (the toughness) with weight 0 changes no step: the same
+// du as the four-response model, to the last bit. With its weight it pulls
+// the step: five responses and four parameters, the least-squares step of
+// the weighted normal equations (here: strengths u2 = 1 on T, K; K wants
+// +0.4, T wants 0: du2 = 0.2 when both weigh 1, with the ratio u3 fixed).
+TEST(LocalModel, FifthResponseCountsOnlyWithItsWeight) {
+  const Mat4 J4{{{1.0, 0.2, 0, 0}, {0, 0.1, 0, 0}, {0, 0, 1.0, 0.8}, {0, 0, 1.0, 0.35}}};
+  MatN<5> J5{};
+  for (size_t i = 0; i < 4; ++i) J5[i] = J4[i];
+  J5[4] = {0.0, -0.5, 1.0, 0.0};
+  const Vec4 e4{0.3, -0.02, 0.4, 0.1};
+  const VecN<5> e5{0.3, -0.02, 0.4, 0.1, -0.7};
+  StepRule r4 = plain_rule();
+  r4.mu = 0.01;
+  StepRuleN<5> r5;
+  r5.weight = {1, 1, 1, 1, 0};
+  r5.mu = r4.mu;
+  r5.scale = r4.scale;
+  r5.max_step = r4.max_step;
+  r5.lower = r4.lower;
+  r5.upper = r4.upper;
+  const Vec4 a = damped_step(J4, e4, Vec4{}, r4), b = damped_step(J5, e5, Vec4{}, r5);
+  for (size_t m = 0; m < 4; ++m) EXPECT_EQ(a[m], b[m]) << m;
+  // Weighted: a T row and a K row on u2 alone, the others fixed.
+  MatN<5> J{};
+  J[3] = {0, 0, 1.0, 0};
+  J[4] = {0, 0, 1.0, 0};
+  StepRuleN<5> r = r5;
+  r.mu = 0.0;
+  r.weight = {0, 0, 0, 1, 1};
+  r.free = {0, 0, 1, 0};
+  const Vec4 du = damped_step(J, VecN<5>{0, 0, 0, 0.0, 0.4}, Vec4{}, r);
+  EXPECT_NEAR(du[2], 0.2, 1e-12);
+  r.weight[4] = 3.0;  // K weighs 9 x T in the squares: du2 = 9 x 0.4 / 10
+  EXPECT_NEAR(damped_step(J, VecN<5>{0, 0, 0, 0.0, 0.4}, Vec4{}, r)[2], 0.36, 1e-12);
+}
