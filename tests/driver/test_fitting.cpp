@@ -428,3 +428,41 @@ TEST(Fitting, ToughnessCountsOnlyWhenItIsATarget) {
   const BondParams pk = with.update({b}, notes);
   EXPECT_GT(pk.tensile, pb.tensile);
 }
+
+// The toughness fit keeps the best compromise, not the most targets met
+// (measured: the 3344-element specimens' iterations 2 and 3,
+// bench/README.md, "The toughness as a target of the fit"): iteration 2
+// meets E, nu and the UCS and misses T by 104 % and K_IC by 37 %; iteration
+// 3 meets E and nu and misses the UCS by 29 %, T by 38 %, K_IC by 31 %. The
+// squared errors in tolerance units sum to 81 and 39: iteration 3 is kept.
+// The four-target fit keeps iteration 2 (three met against two). An
+// iteration that meets every target wins over both; an unusable one never.
+TEST(Fitting, ToughnessFitKeepsTheBestCompromise) {
+  Targets t = kCard;
+  t.toughness = 0.73e6;
+  const Fitting with(t, 0.1), without(kCard, 0.1);
+  BondParams p = start();
+  p.model = BondModel::flat_joint;
+  auto it_of = [&](double E, double nu, double ucs, double T, double kic) {
+    Iteration it = made(p, E, nu, ucs, T);
+    it.scb.emplace();
+    it.scb->r.toughness = kic;
+    return it;
+  };
+  std::vector<Iteration> hist{it_of(20.34e9, 0.1386, 50.64e6, 10.20e6, 0.460e6),
+                              it_of(18.52e9, 0.1537, 35.59e6, 6.90e6, 0.506e6)};
+  for (auto& it : hist) with.score(it);
+  EXPECT_EQ(with.best(hist), 1u);
+  std::vector<Iteration> four = hist;
+  for (auto& it : four) without.score(it);
+  EXPECT_EQ(without.best(four), 0u);
+  // Every target met: kept whatever the others' sums.
+  hist.push_back(it_of(18.9e9, 0.17, 47e6, 5.3e6, 0.70e6));
+  with.score(hist.back());
+  ASSERT_TRUE(hist.back().converged);
+  EXPECT_EQ(with.best(hist), 2u);
+  // An unusable iteration (negative modulus) is never kept.
+  std::vector<Iteration> bad{it_of(-1e9, 0.18, 50e6, 5e6, 0.73e6), hist[1]};
+  for (auto& it : bad) with.score(it);
+  EXPECT_EQ(with.best(bad), 1u);
+}

@@ -311,6 +311,7 @@ bool Fitting::usable(const Iteration& it) {
 // worst error (in tolerance units): an unreachable target must not hide
 // the iteration that meets the others.
 size_t Fitting::best(const std::vector<Iteration>& hist) const {
+  if (fits_toughness()) return best_compromise(hist);
   auto met = [&](const Iteration& it) {
     return (it.err_E <= tol_) + (it.err_ucs <= tol_) + (it.err_t <= tol_) +
            (it.err_nu <= kNuTolerance) + (fits_toughness() && it.err_kic <= tol_);
@@ -320,6 +321,44 @@ size_t Fitting::best(const std::vector<Iteration>& hist) const {
     if (met(hist[i]) > met(hist[best]) ||
         (met(hist[i]) == met(hist[best]) && hist[i].score < hist[best].score))
       best = i;
+  return best;
+}
+
+// With the toughness a target the five targets can pull against each other
+// (docs/calibration.md, "The toughness as a target"), and counting the
+// targets met keeps an iteration that meets three and misses the tensile
+// strength by 104 % (measured, 3344-element specimens) over one that misses
+// three by 20-40 %. Kept instead: an iteration that meets every target (the
+// smallest worst error), else the smallest sum of the squared errors in
+// tolerance units, the objective the joint step minimises
+// (ln(achieved / target) / ln(1 + tolerance) for E, UCS, T and K_IC, the
+// difference / 0.05 for nu). Unusable iterations are never kept.
+size_t Fitting::best_compromise(const std::vector<Iteration>& hist) const {
+  const double w = 1.0 / std::log1p(tol_);
+  auto objective = [&](const Iteration& it) {
+    auto sq = [&](double achieved, double target) {
+      const double e = w * std::log(achieved / target);
+      return e * e;
+    };
+    const double nu = (it.ucs.r.poisson_ratio - t_.nu) / kNuTolerance;
+    return sq(it.ucs.r.youngs_modulus, t_.E) + sq(it.ucs.r.ucs, t_.ucs) +
+           sq(it.br.r.tensile_strength, t_.tensile) +
+           (it.scb ? sq(it.scb->r.toughness, t_.toughness) : 1e300) + nu * nu;
+  };
+  size_t best = 0;
+  bool have = false, met = false;
+  double best_value = 0.0;
+  for (size_t i = 0; i < hist.size(); ++i) {
+    if (!usable(hist[i])) continue;
+    const bool conv = hist[i].converged;
+    const double value = conv ? hist[i].score : objective(hist[i]);
+    if (!have || (conv && !met) || (conv == met && value < best_value)) {
+      best = i;
+      best_value = value;
+      have = true;
+      met = conv;
+    }
+  }
   return best;
 }
 

@@ -86,8 +86,14 @@ class Fitting {
   // linear model (local_model.h).
   BondParams joint_update(const std::vector<Iteration>& hist,
                           std::vector<std::string>& notes) const;
-  // Index of the iteration kept as the result.
+  // Index of the iteration kept as the result: the most targets met, then
+  // the smallest worst error; with the toughness a target,
+  // best_compromise().
   size_t best(const std::vector<Iteration>& hist) const;
+  // The toughness fit's result: an iteration that meets every target (the
+  // smallest worst error), else the smallest sum of squared errors in
+  // tolerance units (the joint step's objective); usable iterations only.
+  size_t best_compromise(const std::vector<Iteration>& hist) const;
   // True when the toughness K_IC is a target (and each iteration runs the
   // semi-circular bend test).
   bool fits_toughness() const { return t_.toughness > 0; }
