@@ -155,6 +155,13 @@ TEST(CalibrationSetsTable, CountsTheSetsThatMeetTheCard) {
   EXPECT_NE(md.find("2 start(s), 1 meeting every target"), std::string::npos) << md;
   EXPECT_NE(md.find("no: UCS 21.0 of 50.0 MPa"), std::string::npos) << md;
   EXPECT_NE(md.find("| 9.80 |"), std::string::npos) << md;  // UCS/T of start 2
+  EXPECT_EQ(md.find("K_IC"), std::string::npos) << md;     // no toughness fit: no column
+  // Sets of the toughness fit carry K_IC: a column, "-" where a set has none.
+  starts[1].report["achieved"]["fracture_toughness"] = 0.684e6;
+  const std::string mk = calibrate::sets_markdown(calibrate::sets_json(starts));
+  EXPECT_NE(mk.find("| UCS/T | K_IC (MPa m^0.5) | meets the card |"), std::string::npos) << mk;
+  EXPECT_NE(mk.find("| 9.80 | 0.684 | yes |"), std::string::npos) << mk;
+  EXPECT_NE(mk.find("| 4.20 | - | no: "), std::string::npos) << mk;
 }
 
 }  // namespace

@@ -96,13 +96,18 @@ std::string cell(const nlohmann::json& achieved, const char* key, double scale, 
 }  // namespace
 
 std::string sets_markdown(const nlohmann::json& sets) {
+  // A K_IC column when the fits aimed at it (calibrate.fit_toughness).
+  bool kic = false;
+  for (const auto& s : sets["sets"])
+    kic = kic || (s["achieved"].is_object() && s["achieved"].contains("fracture_toughness"));
   std::string md = fmt::format(
       "\n## Parameter sets from different starts\n\n{} start(s), {} meeting every target of the "
       "ore card. The breakage stage runs its sweep with each set and reports the band of critical "
       "impact speeds (breakage/calibration_sets.json).\n\n"
       "| start | start factors (E_b, kn/ks, sigma_b, c/sigma_b) | E (GPa) | nu | UCS (MPa) | "
-      "tensile (MPa) | UCS/T | meets the card |\n|---|---|---|---|---|---|---|---|\n",
-      sets.value("starts", 0), sets.value("meeting_card", 0));
+      "tensile (MPa) | UCS/T | {}meets the card |\n|---|---|---|---|---|---|---|{}---|\n",
+      sets.value("starts", 0), sets.value("meeting_card", 0), kic ? "K_IC (MPa m^0.5) | " : "",
+      kic ? "---|" : "");
   for (const auto& s : sets["sets"]) {
     const auto& f = s["start_factors"];
     const auto& a = s["achieved"];
@@ -114,12 +119,13 @@ std::string sets_markdown(const nlohmann::json& sets) {
     std::string missed;
     for (const auto& m : s["not_reached"])
       missed += (missed.empty() ? "" : "; ") + m.get<std::string>();
-    md += fmt::format("| {} | {:.3g}, {:.3g}, {:.3g}, {:.3g} | {} | {} | {} | {} | {} | {} |\n",
+    md += fmt::format("| {} | {:.3g}, {:.3g}, {:.3g}, {:.3g} | {} | {} | {} | {} | {} | {}{} |\n",
                       s["start"].get<int>(), f["bond_modulus"].get<double>(),
                       f["stiffness_ratio"].get<double>(), f["bond_tensile_strength"].get<double>(),
                       f["cohesion_ratio"].get<double>(), cell(a, "youngs_modulus", 1e-9, "{:.2f}"),
                       cell(a, "poisson_ratio", 1.0, "{:.3f}"), cell(a, "ucs", 1e-6, "{:.1f}"),
                       cell(a, "tensile_strength", 1e-6, "{:.2f}"), ratio,
+                      kic ? cell(a, "fracture_toughness", 1e-6, "{:.3f}") + " | " : "",
                       s["meets_card"].get<bool>() ? "yes" : "no: " + missed);
   }
   return md;
