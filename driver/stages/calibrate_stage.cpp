@@ -303,13 +303,17 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
         "the ore card carries calibrated.* fitted to its properties: the job copies them, no lab "
         "tests";
   }
+  // The tests of each iteration (the toughness fit adds the bend test).
+  const char* tests = fits_toughness(ctx.cfg) ? "UCS + Brazilian + semi-circular bend tests (K_IC a "
+                                                "target)"
+                                              : "UCS + Brazilian tests";
   p.jobs.push_back(
       {"calibration", in,
        from_card
            ? fmt::format("copy calibrated.* from the ore card of {}", ctx.cfg.ore.str("name"))
-           : fmt::format("UCS + Brazilian tests on {} elements, fit to {}; then {}{} triaxial{} "
+           : fmt::format("{} on {} elements, fit to {}; then {}{} triaxial{} "
                          "check(s)",
-                         ctx.cfg.doc.integer("calibrate.n_elements"), ctx.cfg.ore.str("name"),
+                         tests, ctx.cfg.doc.integer("calibrate.n_elements"), ctx.cfg.ore.str("name"),
                          ctx.cfg.doc.boolean("calibrate.sensitivity")
                              ? "the levers' sensitivities, "
                              : "",
@@ -327,10 +331,10 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
     const auto f = start_factors(k);
     p.jobs.push_back(
         {start_label(k), ink,
-         fmt::format("UCS + Brazilian tests on {} elements, fit to {} from start {} (the estimate "
+         fmt::format("{} on {} elements, fit to {} from start {} (the estimate "
                      "x {:.3g}, {:.3g}, {:.3g}, {:.3g})",
-                     ctx.cfg.doc.integer("calibrate.n_elements"), ctx.cfg.ore.str("name"), k, f[0],
-                     f[1], f[2], f[3])});
+                     tests, ctx.cfg.doc.integer("calibrate.n_elements"), ctx.cfg.ore.str("name"),
+                     k, f[0], f[1], f[2], f[3])});
   }
   return p;
 }
