@@ -347,6 +347,20 @@ BondParams truth_params() {
   return p;
 }
 
+// The sandstone card with its K_IC (0.73 MPa m^0.5) a target.
+Targets sandstone_with_toughness() {
+  Targets t = kCard;
+  t.toughness = 0.73e6;
+  return t;
+}
+
+// The fit's start with flat joints.
+BondParams flat_start() {
+  BondParams p = start();
+  p.model = BondModel::flat_joint;
+  return p;
+}
+
 // The card material m gives at those parameters, K_IC included.
 Targets card_of(const Material& m) {
   const Iteration card = m.test(truth_params());
@@ -402,11 +416,8 @@ TEST(Fitting, ToughnessOutOfReachIsNeverAQuietPass) {
 // that does not aim at K_IC ignores a bend test that ran (its step is the
 // same with and without it).
 TEST(Fitting, ToughnessCountsOnlyWhenItIsATarget) {
-  Targets t = kCard;
-  t.toughness = 0.73e6;
-  const Fitting with(t, 0.1), without(kCard, 0.1);
-  BondParams p = start();
-  p.model = BondModel::flat_joint;
+  const Fitting with(sandstone_with_toughness(), 0.1), without(kCard, 0.1);
+  const BondParams p = flat_start();
   Iteration it = made(p, 18.69e9, 0.18, 50e6, 5e6);
   with.score(it);
   EXPECT_FALSE(it.converged) << "no bend test: K_IC is not met";
@@ -438,11 +449,8 @@ TEST(Fitting, ToughnessCountsOnlyWhenItIsATarget) {
 // The four-target fit keeps iteration 2 (three met against two). An
 // iteration that meets every target wins over both; an unusable one never.
 TEST(Fitting, ToughnessFitKeepsTheBestCompromise) {
-  Targets t = kCard;
-  t.toughness = 0.73e6;
-  const Fitting with(t, 0.1), without(kCard, 0.1);
-  BondParams p = start();
-  p.model = BondModel::flat_joint;
+  const Fitting with(sandstone_with_toughness(), 0.1), without(kCard, 0.1);
+  const BondParams p = flat_start();
   auto it_of = [&](double E, double nu, double ucs, double T, double kic) {
     Iteration it = made(p, E, nu, ucs, T);
     it.scb.emplace();
