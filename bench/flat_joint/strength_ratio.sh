@@ -17,7 +17,8 @@
 # bond_extra (more keywords for both models, e.g. bond_extra="unbonded_seed 7"),
 # models="parallel flatjoint", tests="ucs brazilian scb" to add the
 # semi-circular bend test of the toughness check (scb_r=... its carve radius,
-# default the disc's), ...).
+# default the disc's; scb_angle=... turns the ball about the load axis before
+# carving, deg: another half disc from the same packing), ...).
 set -eu
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
@@ -35,7 +36,7 @@ bond_modulus=9.9925879e10 stiffness_ratio=3.9440781 bond_tensile=24943466
 bond_cohesion=49886932 bond_friction=30 moment_factor=0 radius_mult=1.0
 bond_gap=0.15 max_bonds=16 rate=2 elements="1 3" joint_friction=-1 unbonded_frac=0
 fj_extra="" bond_extra="" models="parallel flatjoint" tests="ucs brazilian"
-ucs_r=0.0131578 disc_r=0.0209757
+ucs_r=0.0131578 disc_r=0.0209757 scb_angle=0
 for kv in "$@"; do
   key=${kv%%=*}
   case "$key" in *[!a-z_]* | "") echo "strength_ratio: '$kv' is not key=value" >&2; exit 2 ;; esac
@@ -78,7 +79,8 @@ run_test() {
       -var bond_cohesion "$bond_cohesion" -var bond_friction "$bond_friction" \
       -var bond_style "$( [ "$4" = flatjoint ] && echo flatjoint || echo breakable )" \
       -var bond_model_keys "$(model_keys "$4")" -var radius_mult "$radius_mult" \
-      -var bond_gap "$bond_gap" -var max_bonds "$max_bonds" -var unbonded_frac "$unbonded_frac") ||
+      -var bond_gap "$bond_gap" -var max_bonds "$max_bonds" -var unbonded_frac "$unbonded_frac" \
+      $( [ "$1" = scb ] && echo "-var carve_angle $scb_angle" )) ||
     { echo "strength_ratio: $4 $1 failed: see $dir/liggghts.log" >&2; exit 1; }
 }
 

@@ -469,6 +469,13 @@ std::vector<KeyDef> calibrate_keys() {
           "(its lever: the bond tensile strength against the cohesion). false: K_IC is a check after the "
           "fit only, as it always is for the parallel bond (docs/calibration.md, \"The toughness as a "
           "target\")"),
+      range(key("calibrate.scb_orientations", T::Int, "", "6",
+                "With an ore card that gives fracture_toughness: half discs per semi-circular bend test, each "
+                "carved from the specimen ball turned a further 180 deg / N about the load axis; K_IC is their "
+                "mean, reported with its standard error and range. One half disc of a few hundred elements "
+                "scatters K_IC by tens of per cent with where its notch cuts the packing (docs/calibration.md, "
+                "\"The toughness as a target\"). Each half disc costs a few seconds per bend test"),
+            1, false, 12, false),
       key("calibrate.rate_check", T::Bool, "", "true",
           "After the fit, repeat the UCS test at half the strain rate (quasi-static check)"),
       key("calibrate.sensitivity", T::Bool, "", "true",

@@ -93,6 +93,7 @@ class Calibration {
     n_ = d_.integer("calibrate.n_elements");
     rate_ = d_.real("calibrate.strain_rate");
     max_it_ = static_cast<int>(d_.integer("calibrate.max_iterations"));
+    scb_orientations_ = static_cast<int>(d_.integer("calibrate.scb_orientations"));
   }
 
   // The whole calibration: specimen, iterations, rate check, outputs.
@@ -109,6 +110,7 @@ class Calibration {
   double rate_ = 0.5;
   long n_ = 0;
   int max_it_ = 1;
+  int scb_orientations_ = 1;  // half discs of each bend test
 };
 
 // The calibration: pack, iterate the two tests, check the rate, step each
@@ -174,7 +176,7 @@ void Calibration::run() {
         {fmt::format("it{}_brazilian", k), fmt::format("iteration {}/{}: Brazilian", k, max_it_),
          (per_it * (k - 1) + 1) / steps_total});
     if (fit_.fits_toughness())
-      it.scb = lab.scb(p, rate_,
+      it.scb = lab.scb(p, rate_, scb_orientations_,
                        {fmt::format("it{}_scb", k),
                         fmt::format("iteration {}/{}: semi-circular bend", k, max_it_),
                         (per_it * (k - 1) + 2) / steps_total});
@@ -186,8 +188,7 @@ void Calibration::run() {
         "{:.2f} MPa ({:.2f}){}{} [{:.0f} s + {:.0f} s{}]",
         k, max_it_, it.ucs.r.youngs_modulus / 1e9, t.E / 1e9, it.ucs.r.poisson_ratio, t.nu,
         it.ucs.r.ucs / 1e6, t.ucs / 1e6, it.br.r.tensile_strength / 1e6, t.tensile / 1e6,
-        it.scb ? fmt::format(", K_IC {:.3f} MPa m^0.5 ({:.3f})", it.scb->r.toughness / 1e6,
-                             t.toughness / 1e6)
+        it.scb ? fmt::format(", K_IC {} ({:.3f})", it.scb->summary(), t.toughness / 1e6)
                : "",
         it.converged ? ": all within tolerance" : "", it.ucs.seconds, it.br.seconds,
         it.scb ? fmt::format(" + {:.0f} s", it.scb->seconds) : ""));
@@ -228,7 +229,8 @@ void Calibration::run() {
     o.checks =
         run_checks(lab, hist[o.best].p, hist[o.best].ucs, rate_,
                    confining_pressures(d_, hist[o.best].ucs.r.ucs), check_for,
-                   (per_it * max_it_ + 2.0 + n_sensitivity) / steps_total, 1.0 / steps_total);
+                   (per_it * max_it_ + 2.0 + n_sensitivity) / steps_total, 1.0 / steps_total,
+                   scb_orientations_, hist[o.best].scb ? &*hist[o.best].scb : nullptr);
   o.checks.toughness_fitted = fit_.fits_toughness();
   o.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_outputs(ctx_, dir_, fit_, o);
@@ -287,6 +289,12 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
   // The toughness fit is an input only where it acts (flat joints, a card
   // with K_IC): a parallel-bond calibration keeps its job id.
   if (!fits_toughness(ctx.cfg)) in.erase("calibrate.fit_toughness");
+  // The bend test's half discs are an input only where it runs (a card with
+  // K_IC); with it, the half disc's radius factor (it moved from 1.0 to 1.2).
+  if (ctx.cfg.ore.has("fracture_toughness"))
+    in["scb_radius_factor"] = kScbRadiusFactor;
+  else
+    in.erase("calibrate.scb_orientations");
   in["ore"] = config::ore_keys(ctx.cfg.ore);
   for (const char* k : config::kOreCheckKeys)
     if (ctx.cfg.ore.has(k)) in["ore_checks"][k] = ctx.cfg.ore.real(k);

@@ -97,17 +97,43 @@ TEST(CalibrateEnergy, CheckRunsComeLastAndCount) {
     o.checks.triaxial.back().tag = tag;
   }
   o.checks.scb = ScbRun{};
-  o.checks.scb->tag = "scb";
-  o.checks.scb->energy = ledger(0.0, 3e-3, 1e-3, 1e-4);
-  o.checks.scb->energy.residual_fraction_max = 6e-3;
+  for (const char* tag : {"scb", "scb_o1"}) {
+    o.checks.scb->discs.emplace_back();
+    o.checks.scb->discs.back().tag = tag;
+    o.checks.scb->discs.back().energy = ledger(0.0, 3e-3, 1e-3, 1e-4);
+  }
+  o.checks.scb->discs.back().energy.residual_fraction_max = 6e-3;
   const auto runs = lab_runs(o);
-  ASSERT_EQ(runs.size(), 6u);
+  ASSERT_EQ(runs.size(), 7u);
   EXPECT_EQ(runs[3]->tag, "triaxial_1");
   EXPECT_EQ(runs[4]->tag, "triaxial_2");
   EXPECT_EQ(runs[5]->tag, "scb");
-  EXPECT_EQ(energy_summary_json(o).at("worst_run").get<std::string>(), "scb");
+  EXPECT_EQ(runs[6]->tag, "scb_o1");
+  EXPECT_EQ(energy_summary_json(o).at("worst_run").get<std::string>(), "scb_o1");
   const std::string md = energy_markdown(o);
-  for (const char* row : {"| triaxial_1 |", "| triaxial_2 |", "| scb |"})
+  for (const char* row : {"| triaxial_1 |", "| triaxial_2 |", "| scb |", "| scb_o1 |"})
+    EXPECT_NE(md.find(row), std::string::npos) << row << " in\n" << md;
+}
+
+// With K_IC fitted the checks' bend test is the kept iteration's own: its
+// half discs are listed once, with the iteration, marked as the result's.
+TEST(CalibrateEnergy, FittedBendTestIsListedOnceWithItsIteration) {
+  Outcome o;
+  o.hist = {iteration(1, 1e-5, 3e-4)};
+  o.hist[0].scb.emplace();
+  for (const char* tag : {"it1_scb", "it1_scb_o1", "it1_scb_o2"}) {
+    o.hist[0].scb->discs.emplace_back();
+    o.hist[0].scb->discs.back().tag = tag;
+    o.hist[0].scb->discs.back().energy = ledger(0.0, 3e-3, 1e-3, 1e-4);
+  }
+  o.checks.scb = o.hist[0].scb;
+  o.checks.toughness_fitted = true;
+  const auto runs = lab_runs(o);
+  ASSERT_EQ(runs.size(), 5u);
+  EXPECT_EQ(runs[2]->tag, "it1_scb");
+  EXPECT_EQ(runs[4]->tag, "it1_scb_o2");
+  const std::string md = energy_markdown(o);
+  for (const char* row : {"| it1_scb * |", "| it1_scb_o1 * |", "| it1_scb_o2 * |"})
     EXPECT_NE(md.find(row), std::string::npos) << row << " in\n" << md;
 }
 

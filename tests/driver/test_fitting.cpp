@@ -204,7 +204,7 @@ struct Material {
     it.br.r.tensile_strength = T;
     if (kic_per_sigma > 0) {
       it.scb.emplace();
-      it.scb->r.toughness = kic_per_sigma * p.tensile * std::exp(0.05 * lr - 0.05 * lk);
+      it.scb->toughness = kic_per_sigma * p.tensile * std::exp(0.05 * lr - 0.05 * lk);
     }
     return it;
   }
@@ -366,7 +366,7 @@ Targets card_of(const Material& m) {
   const Iteration card = m.test(truth_params());
   Targets t{card.ucs.r.youngs_modulus, card.ucs.r.poisson_ratio, card.ucs.r.ucs,
             card.br.r.tensile_strength};
-  t.toughness = card.scb->r.toughness;
+  t.toughness = card.scb->toughness;
   return t;
 }
 
@@ -425,7 +425,7 @@ TEST(Fitting, ToughnessCountsOnlyWhenItIsATarget) {
   EXPECT_TRUE(it.converged);
   Iteration a = made(p, 15e9, 0.25, 30e6, 4e6), b = a;
   b.scb.emplace();
-  b.scb->r.toughness = 0.1e6;
+  b.scb->toughness = 0.1e6;
   without.score(a);
   without.score(b);
   std::vector<std::string> notes;
@@ -454,7 +454,7 @@ TEST(Fitting, ToughnessFitKeepsTheBestCompromise) {
   auto it_of = [&](double E, double nu, double ucs, double T, double kic) {
     Iteration it = made(p, E, nu, ucs, T);
     it.scb.emplace();
-    it.scb->r.toughness = kic;
+    it.scb->toughness = kic;
     return it;
   };
   std::vector<Iteration> hist{it_of(20.34e9, 0.1386, 50.64e6, 10.20e6, 0.460e6),

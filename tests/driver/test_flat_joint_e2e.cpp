@@ -64,8 +64,11 @@ TEST(FlatJointBreakage, ImpactsRunWithFlatJointsAndConserveEnergy) {
 // docs/calibration.md, "The toughness as a target"): a tiny flat-joint
 // calibration of the sandstone card (K_IC 0.73 MPa m^0.5) runs the
 // semi-circular bend test in every iteration, each with its energy ledger,
-// and reports K_IC as a target beside E, nu, UCS and T. The same case with
-// the key off is another job, whose iterations run no bend test.
+// and reports K_IC as a target beside E, nu, UCS and T; each bend test is
+// two half discs (calibrate.scb_orientations: 2), K_IC their mean, and the
+// check after the fit reports the kept iteration's test without running it
+// again. The same case with the key off is another job, whose iterations run
+// no bend test.
 TEST(FlatJointCalibration, ToughnessIsATargetOfTheFit) {
   const fs::path dir = scratch("flat_joint_kic");
   const std::string base =
@@ -77,7 +80,7 @@ TEST(FlatJointCalibration, ToughnessIsATargetOfTheFit) {
   // load point (the stage stops on it: ScbTooCoarse).
   const std::string cal =
       "calibrate: {n_elements: 400, strain_rate: 2.0, seed: 2003, rate_check: false, "
-      "sensitivity: false, confining_pressures: [0.1]";
+      "sensitivity: false, confining_pressures: [0.1], scb_orientations: 2";
   spit(dir / "on.yaml", "name: kic_on\n" + base + cal + ", max_iterations: 2}\n");
   spit(dir / "off.yaml",
        "name: kic_off\n" + base + cal + ", max_iterations: 1, fit_toughness: false}\n");
@@ -100,20 +103,41 @@ TEST(FlatJointCalibration, ToughnessIsATargetOfTheFit) {
         << "iteration " << k + 1 << ": " << kic;
     EXPECT_NEAR(it["errors"]["fracture_toughness"].get<double>(), std::abs(kic / 0.73e6 - 1.0),
                 1e-9);
-    // Every bend test's energy ledger closes (the decks stop past 1 %).
-    EXPECT_LT(std::abs(it["energy"]["scb"].value("residual_fraction_max", 1.0)), 0.01) << k;
-    EXPECT_TRUE(fs::exists(job / "runs" / fmt::format("it{}_scb", k + 1) / "ledger.csv")) << k;
+    // Two half discs, the second carved from the ball turned 90 deg; K_IC
+    // is their mean; every disc's energy ledger closes (the decks stop past 1 %).
+    const auto& discs = it["scb_discs"];
+    ASSERT_EQ(discs.size(), 2u) << it.dump(2);
+    EXPECT_EQ(discs[0]["run"], fmt::format("it{}_scb", k + 1));
+    EXPECT_EQ(discs[1]["run"], fmt::format("it{}_scb_o1", k + 1));
+    EXPECT_DOUBLE_EQ(discs[1]["angle_deg"].get<double>(), 90.0);
+    const double k0 = discs[0]["fracture_toughness_Pa_m0.5"].get<double>();
+    const double k1 = discs[1]["fracture_toughness_Pa_m0.5"].get<double>();
+    EXPECT_NEAR(kic, 0.5 * (k0 + k1), 1e-9 * kic) << k;
+    EXPECT_NEAR(it["fracture_toughness_sem_Pa_m0.5"].get<double>(), 0.5 * std::abs(k0 - k1),
+                1e-9 * kic)
+        << k;
+    ASSERT_EQ(it["energy"]["scb"].size(), 2u) << k;
+    for (const auto& e : it["energy"]["scb"])
+      EXPECT_LT(std::abs(e.value("residual_fraction_max", 1.0)), 0.01) << k;
+    for (const char* tail : {"", "_o1"})
+      EXPECT_TRUE(fs::exists(job / "runs" / fmt::format("it{}_scb{}", k + 1, tail) / "ledger.csv"))
+          << k << tail;
   }
   EXPECT_TRUE(r["checks"].value("toughness_fitted", false));
-  // The check after the fit repeats the result's bend test: the same K_IC.
+  // The check after the fit is the result's own bend test, not run again.
   const auto& ck = r["checks"];
   ASSERT_TRUE(ck["scb"].is_object()) << ck.dump(2);
   const double kic_check = ck["scb"]["fracture_toughness_Pa_m0.5"].get<double>();
   EXPECT_NEAR(kic_check, r["achieved"]["fracture_toughness"].get<double>(), 1e-6 * kic_check);
   EXPECT_DOUBLE_EQ(ck["against_card"]["fracture_toughness"]["achieved"].get<double>(), kic_check);
-  EXPECT_LT(std::abs(ck["scb"]["energy"].value("residual_fraction_max", 1.0)), 0.01);
+  EXPECT_EQ(ck["scb"]["half_discs"].get<int>(), 2);
+  EXPECT_EQ(ck["scb"]["run"].get<std::string>().rfind("it", 0), 0u) << ck["scb"]["run"];
+  EXPECT_FALSE(fs::exists(job / "runs" / "scb"));
   const std::string md = slurp(job / "report.md");
-  EXPECT_NE(md.find("| K_IC (MPa m^0.5; semi-circular bend) | 0.730 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| K_IC (MPa m^0.5; semi-circular bend, mean of 2 half discs +- its standard "
+                    "error) | 0.730 |"),
+            std::string::npos)
+      << md;
   EXPECT_NE(md.find("K_IC (MPa m^0.5) | wall (s) |"), std::string::npos) << md;
   const YAML::Node y = YAML::LoadFile((run / "calibrate" / "calibrated.yaml").string());
   EXPECT_DOUBLE_EQ(y["targets"]["fracture_toughness"].as<double>(), 0.73e6);
@@ -128,7 +152,9 @@ TEST(FlatJointCalibration, ToughnessIsATargetOfTheFit) {
       << slurp(dir / "off.log");
   const fs::path job_off = run_off / "calibrate" / "jobs" / "calibration";
   EXPECT_FALSE(fs::exists(job_off / "runs" / "it1_scb"));
-  EXPECT_TRUE(fs::exists(job_off / "runs" / "scb"));  // the check after the fit
+  // The check after the fit: its own two half discs.
+  EXPECT_TRUE(fs::exists(job_off / "runs" / "scb" / "ledger.csv"));
+  EXPECT_TRUE(fs::exists(job_off / "runs" / "scb_o1" / "ledger.csv"));
   const auto r_off = nlohmann::json::parse(slurp(job_off / "report.json"));
   EXPECT_FALSE(r_off["targets"].contains("fracture_toughness"));
   EXPECT_NE(nlohmann::json::parse(slurp(job / "job.json")).value("id", std::string("a")),

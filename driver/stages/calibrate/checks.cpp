@@ -54,7 +54,7 @@ std::vector<double> confining_pressures(const config::Document& d, double ucs_re
 // Triaxial runs, the envelope through their peaks and the UCS, then the SCB run.
 Checks run_checks(LabBench& lab, const BondParams& p, const UcsRun& ucs, double rate,
                   const std::vector<double>& pressures, const CheckTargets& targets, double done,
-                  double step_share) {
+                  double step_share, int scb_orientations, const ScbRun* fitted_scb) {
   Checks c;
   c.targets = targets;
   std::vector<post::StrengthPoint> points = {{0.0, ucs.r.ucs}};
@@ -83,9 +83,11 @@ Checks run_checks(LabBench& lab, const BondParams& p, const UcsRun& ucs, double 
   } catch (const std::exception& e) {
     c.envelope_error += (c.envelope_error.empty() ? "" : "; ") + std::string(e.what());
   }
-  if (targets.fracture_toughness) {
+  if (targets.fracture_toughness && fitted_scb) {
+    c.scb = *fitted_scb;
+  } else if (targets.fracture_toughness) {
     try {
-      c.scb = lab.scb(p, rate,
+      c.scb = lab.scb(p, rate, scb_orientations,
                       {"scb", "check: semi-circular bend",
                        done + static_cast<double>(pressures.size()) * step_share});
     } catch (const ScbTooCoarse& e) {
@@ -96,7 +98,7 @@ Checks run_checks(LabBench& lab, const BondParams& p, const UcsRun& ucs, double 
       throw std::runtime_error(fmt::format("check scb (runs/scb): {}", e.what()));
     }
   }
-  if (c.scb && !c.scb->peaked) c.notes.push_back("scb: reached its cap still loading");
+  if (c.scb && !c.scb->peaked) c.notes.push_back("scb: a half disc reached its cap still loading");
   return c;
 }
 
@@ -129,21 +131,35 @@ nlohmann::json checks_json(const Checks& c, double ucs_peak) {
       {"error",
        c.envelope_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.envelope_error)}};
   nlohmann::json scb = nullptr;
-  if (c.scb)
-    scb = {{"run", c.scb->tag},
-           {"peak_force_N", c.scb->r.peak_force},
-           {"geometry_factor", c.scb->r.geometry_factor},
-           {"fracture_toughness_Pa_m0.5", c.scb->r.toughness},
+  if (c.scb) {
+    nlohmann::json discs = nlohmann::json::array();
+    for (const ScbDisc& d : c.scb->discs)
+      discs.push_back({{"run", d.tag},
+                       {"angle_deg", d.angle_deg},
+                       {"elements", d.info.count("atoms") ? d.info.at("atoms") : 0.0},
+                       {"radius_m", d.info.count("radius") ? d.info.at("radius") : 0.0},
+                       {"peak_force_N", d.r.peak_force},
+                       {"geometry_factor", d.r.geometry_factor},
+                       {"fracture_toughness_Pa_m0.5", d.r.toughness},
+                       {"peaked", d.peaked},
+                       {"energy", lab_energy_json(d.energy)},
+                       {"wall_seconds", d.seconds}});
+    scb = {{"run", c.scb->tag()},
+           {"half_discs", c.scb->discs.size()},
+           {"peak_force_N", c.scb->peak_force},
+           {"fracture_toughness_Pa_m0.5", c.scb->toughness},
+           {"fracture_toughness_sem_Pa_m0.5", c.scb->toughness_sem},
            {"peaked", c.scb->peaked},
-           {"energy", lab_energy_json(c.scb->energy)},
+           {"discs", discs},
            {"wall_seconds", c.scb->seconds}};
+  }
   const auto mc = [&](auto f) { return c.mc ? std::optional<double>(f(*c.mc)) : std::nullopt; };
   return {
       {"note",
        c.toughness_fitted
            ? "checks with the result's bond parameters; the envelope is not fitted (no bond "
              "parameter moves on it); K_IC was a target of the fit (calibrate.fit_toughness): its "
-             "bend test here repeats the result's"
+             "bend test here is the result's own, not run again"
            : "checks with the result's bond parameters, not fitted: not a lever yet (no bond "
              "parameter moves on them)"},
       {"toughness_fitted", c.toughness_fitted},
@@ -159,7 +175,7 @@ nlohmann::json checks_json(const Checks& c, double ucs_peak) {
          compared(c.targets.hoek_brown_mi, c.hb ? std::optional<double>(c.hb->m_i) : std::nullopt)},
         {"fracture_toughness",
          compared(c.targets.fracture_toughness,
-                  c.scb ? std::optional<double>(c.scb->r.toughness) : std::nullopt)}}}};
+                  c.scb ? std::optional<double>(c.scb->toughness) : std::nullopt)}}}};
 }
 
 // Peaks, envelope and the card's values, with what they are not.
@@ -170,8 +186,8 @@ std::string checks_markdown(const Checks& c, double ucs_peak) {
         "docs/calibration.md) and, when the ore card gives K_IC, a semi-circular bend test. ";
   md << (c.toughness_fitted
              ? "The envelope is a check, not fitted: no bond parameter moves on it. K_IC was a "
-               "target of the fit (calibrate.fit_toughness): the bend test here repeats the "
-               "result's.\n\n"
+               "target of the fit (calibrate.fit_toughness): the bend test here is the "
+               "result's own, not run again.\n\n"
              : "These are checks, not fitted: no bond parameter moves on them.\n\n");
   md << "| run | sigma_3 (MPa) | peak sigma_1 (MPa) | sigma_1 - sigma_3 (MPa) | peaked |\n"
         "|---|---|---|---|---|\n";
@@ -192,16 +208,16 @@ std::string checks_markdown(const Checks& c, double ucs_peak) {
   if (!c.envelope_error.empty()) md << "Not fitted: " << c.envelope_error << ".";
   md << "\n";
   if (c.scb)
-    md << fmt::format("\nSemi-circular bend: peak {:.1f} N, Y' {:.2f}, K_IC {:.3f} MPa m^0.5{}.\n",
-                      c.scb->r.peak_force, c.scb->r.geometry_factor, c.scb->r.toughness / 1e6,
-                      c.scb->peaked ? "" : " (reached its cap still loading)");
+    md << fmt::format("\nSemi-circular bend: mean peak {:.1f} N, K_IC {}{}.\n",
+                      c.scb->peak_force, c.scb->summary(),
+                      c.scb->peaked ? "" : " (a half disc reached its cap still loading)");
   md << "\n| property | ore card | achieved | error |\n|---|---|---|---|\n";
   md << compared_row("friction angle (deg)", c.targets.friction_angle_deg,
                      c.mc ? std::optional<double>(c.mc->friction_angle_deg) : std::nullopt, 1.0, 1);
   md << compared_row("Hoek-Brown m_i", c.targets.hoek_brown_mi,
                      c.hb ? std::optional<double>(c.hb->m_i) : std::nullopt, 1.0, 1);
   md << compared_row("K_IC (MPa m^0.5)", c.targets.fracture_toughness,
-                     c.scb ? std::optional<double>(c.scb->r.toughness) : std::nullopt, 1e6, 3);
+                     c.scb ? std::optional<double>(c.scb->toughness) : std::nullopt, 1e6, 3);
   if (!c.notes.empty()) md << "\n";
   for (const std::string& n : c.notes) md << "- " << n << "\n";
   return md.str();

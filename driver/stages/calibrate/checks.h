@@ -44,10 +44,13 @@ std::vector<double> confining_pressures(const config::Document& d, double ucs_re
 
 // Runs the checks with bond parameters p; `ucs` is the result's UCS test
 // (the envelope's point at sigma_3 = 0). Each run's progress starts at
-// done + k x step_share of the job.
+// done + k x step_share of the job. The bend test (a card with K_IC) runs
+// scb_orientations half discs, unless `fitted_scb` is given: the result's own
+// bend test from the fit (calibrate.fit_toughness), which the check reports
+// instead of repeating it.
 Checks run_checks(LabBench& lab, const BondParams& p, const UcsRun& ucs, double rate,
                   const std::vector<double>& pressures, const CheckTargets& targets, double done,
-                  double step_share);
+                  double step_share, int scb_orientations, const ScbRun* fitted_scb = nullptr);
 
 // report.json's `checks` object.
 nlohmann::json checks_json(const Checks& c, double ucs_peak);

@@ -42,7 +42,8 @@ std::vector<const LabRun*> lab_runs(const Outcome& o) {
   for (const Iteration& it : o.hist) {
     runs.push_back(&it.ucs);
     runs.push_back(&it.br);
-    if (it.scb) runs.push_back(&*it.scb);
+    if (it.scb)
+      for (const ScbDisc& d : it.scb->discs) runs.push_back(&d);
   }
   if (o.half) runs.push_back(&*o.half);
   for (const LeverRun& l : o.sensitivity) {
@@ -50,7 +51,9 @@ std::vector<const LabRun*> lab_runs(const Outcome& o) {
     runs.push_back(&l.br);
   }
   for (const TriaxialRun& t : o.checks.triaxial) runs.push_back(&t);
-  if (o.checks.scb) runs.push_back(&*o.checks.scb);
+  // The checks' bend test is the kept iteration's own when K_IC was fitted.
+  if (o.checks.scb && !o.checks.toughness_fitted)
+    for (const ScbDisc& d : o.checks.scb->discs) runs.push_back(&d);
   return runs;
 }
 
@@ -68,7 +71,7 @@ nlohmann::json energy_summary_json(const Outcome& o) {
          "jobs/calibration/runs/<run>/ledger.csv (fix energy/ledger, "
          "docs/styles/fix_energy_ledger.md); each run's figures are in its `energy` object "
          "(iterations[].energy.ucs, .brazilian, rate_check.energy, "
-         "sensitivity.levers.<lever>.energy, checks.triaxial[].energy, checks.scb.energy)"},
+         "sensitivity.levers.<lever>.energy, checks.triaxial[].energy, checks.scb.discs[].energy)"},
         {"work_other_J",
          "the platens' drive: work done on the specimen by the moving platens (triaxial: and by "
          "the confining forces)"},
@@ -95,8 +98,9 @@ std::string energy_markdown(const Outcome& o) {
   const Iteration* best = o.hist.empty() ? nullptr : &o.hist[o.best];
   for (const LabRun* r : runs) {
     const post::LedgerSummary& e = r->energy;
-    const bool result =
-        best && (r == &best->ucs || r == &best->br || (best->scb && r == &*best->scb));
+    bool result = best && (r == &best->ucs || r == &best->br);
+    if (best && best->scb)
+      for (const ScbDisc& d : best->scb->discs) result = result || r == &d;
     md << fmt::format(
         "| {}{} | {:.4g} | {:.4g} | {:.4g} | {:.3g} | {:.3g}% | {:.3g}% | {:.3g} | {:.3g}% |\n",
         r->tag, result ? " *" : "", e.input_J, e.work_other_J, e.bond_released_J, e.residual_J,

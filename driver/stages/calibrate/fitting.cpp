@@ -22,7 +22,7 @@ void Fitting::score(Iteration& it) const {
   // K_IC: a target only with the toughness fit; an iteration without its
   // bend test then misses it.
   it.err_kic = !fits_toughness() ? 0.0
-               : it.scb          ? post::RelativeError(it.scb->r.toughness, t_.toughness)
+               : it.scb          ? post::RelativeError(it.scb->toughness, t_.toughness)
                                  : 1e300;
   it.score = std::max({it.err_E / tol_, it.err_ucs / tol_, it.err_t / tol_,
                        it.err_nu / kNuTolerance, it.err_kic / tol_});
@@ -41,7 +41,7 @@ Vec4 params_of(const BondParams& p) {
 // and ln K_IC (0 without a bend test: then not a target, weight 0).
 FitVec responses_of(const Iteration& it) {
   return {std::log(it.ucs.r.youngs_modulus), it.ucs.r.poisson_ratio, std::log(it.ucs.r.ucs),
-          std::log(it.br.r.tensile_strength), it.scb ? std::log(it.scb->r.toughness) : 0.0};
+          std::log(it.br.r.tensile_strength), it.scb ? std::log(it.scb->toughness) : 0.0};
 }
 
 // True when two iterations were made with the same coarse levers (moment
@@ -302,7 +302,7 @@ BondParams Fitting::update(const std::vector<Iteration>& hist,
 bool Fitting::usable(const Iteration& it) {
   const double E = it.ucs.r.youngs_modulus, nu = it.ucs.r.poisson_ratio, ucs = it.ucs.r.ucs,
                t = it.br.r.tensile_strength;
-  const double k = it.scb ? it.scb->r.toughness : 1.0;
+  const double k = it.scb ? it.scb->toughness : 1.0;
   return std::isfinite(E) && std::isfinite(nu) && std::isfinite(ucs) && std::isfinite(t) &&
          std::isfinite(k) && E > 0 && ucs > 0 && t > 0 && k > 0;
 }
@@ -343,7 +343,7 @@ size_t Fitting::best_compromise(const std::vector<Iteration>& hist) const {
     const double nu = (it.ucs.r.poisson_ratio - t_.nu) / kNuTolerance;
     return sq(it.ucs.r.youngs_modulus, t_.E) + sq(it.ucs.r.ucs, t_.ucs) +
            sq(it.br.r.tensile_strength, t_.tensile) +
-           (it.scb ? sq(it.scb->r.toughness, t_.toughness) : 1e300) + nu * nu;
+           (it.scb ? sq(it.scb->toughness, t_.toughness) : 1e300) + nu * nu;
   };
   size_t best = 0;
   bool have = false, met = false;

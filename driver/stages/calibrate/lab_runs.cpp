@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <regex>
@@ -143,32 +144,82 @@ TriaxialRun LabBench::triaxial(const BondParams& p, double rate, double pressure
   return t;
 }
 
-// A semi-circular bend test on a half disc of the Brazilian disc's carve
-// radius; its load-point closure over 2R at the peak taken as the Brazilian
-// disc's (4 tensile / E), the cap twice as far: bending is more compliant.
-ScbRun LabBench::scb(const BondParams& p, double rate, const RunStep& step) {
+// The semi-circular bend test: `orientations` half discs of kScbRadiusFactor
+// x the Brazilian disc's carve radius, each carved from the ball turned by
+// 180 deg / orientations more about the load axis (the notch planes then cut
+// the packing in different places); its load-point closure over 2R at the
+// peak taken as the Brazilian disc's (4 tensile / E), the cap ten times as
+// far: bending is more compliant.
+ScbRun LabBench::scb(const BondParams& p, double rate, int orientations, const RunStep& step) {
+  if (orientations < 1)
+    throw std::runtime_error(fmt::format(
+        "calibrate.scb_orientations: expected at least 1, got {}", orientations));
+  std::vector<ScbDisc> discs;
+  for (int k = 0; k < orientations; ++k) {
+    ScbDisc d;
+    d.angle_deg = 180.0 * k / orientations;
+    const RunStep disc_step{k == 0 ? step.tag : fmt::format("{}_o{}", step.tag, k),
+                            orientations == 1
+                                ? step.what
+                                : fmt::format("{} {}/{}", step.what, k + 1, orientations),
+                            step.done};
+    const fs::path work = run_test({"scb",
+                                    kScbRadiusFactor * sp_.disc_r,
+                                    4.0 * t_.tensile / t_.E,
+                                    10.0,
+                                    {{"carve_angle", num(d.angle_deg)}}},
+                                   p, rate, disc_step, d);
+    // A half disc too coarse for the three-point bend has no element under
+    // the load point or over a support: its "peak" would be noise. Measured:
+    // 200-element specimens (56 elements in the half disc) leave the load
+    // point empty; 400 give 2 and 6.
+    for (const char* layer : {"load_layer", "support_layer"})
+      if (info_at(d.info, layer, d.info_file) < 1)
+        throw ScbTooCoarse(fmt::format(
+            "{}: the semi-circular bend specimen ({:g} elements) has no element in its {} "
+            "(load_layer {:g}, support_layer {:g}): calibrate.n_elements is too few for the "
+            "toughness test; use at least 400, or drop fracture_toughness from the ore card",
+            d.info_file.string(), info_at(d.info, "atoms", d.info_file), layer,
+            info_at(d.info, "load_layer", d.info_file),
+            info_at(d.info, "support_layer", d.info_file)));
+    d.curve = post::ReadLoadCurve((work / "scb_curve.txt").string());
+    d.r = post::AnalyseScb(
+        d.curve, info_at(d.info, "radius", d.info_file), info_at(d.info, "thickness", d.info_file),
+        info_at(d.info, "notch", d.info_file), info_at(d.info, "half_span", d.info_file));
+    d.peaked = d.r.peak_index + 1 < d.curve.size();
+    discs.push_back(std::move(d));
+  }
+  return ScbRun::of(std::move(discs));
+}
+
+ScbRun ScbRun::of(std::vector<ScbDisc> discs) {
+  if (discs.empty()) throw std::logic_error("ScbRun::of: no half disc");
   ScbRun s;
-  const fs::path work =
-      run_test({"scb", sp_.disc_r, 4.0 * t_.tensile / t_.E, 10.0}, p, rate, step, s);
-  // A half disc too coarse for the three-point bend has no element under
-  // the load point or over a support: its "peak" would be noise. Measured:
-  // 200-element specimens (56 elements in the half disc) leave the load
-  // point empty; 400 give 2 and 6.
-  for (const char* layer : {"load_layer", "support_layer"})
-    if (info_at(s.info, layer, s.info_file) < 1)
-      throw ScbTooCoarse(fmt::format(
-          "{}: the semi-circular bend specimen ({:g} elements) has no element in its {} "
-          "(load_layer {:g}, support_layer {:g}): calibrate.n_elements is too few for the "
-          "toughness test; use at least 400, or drop fracture_toughness from the ore card",
-          s.info_file.string(), info_at(s.info, "atoms", s.info_file), layer,
-          info_at(s.info, "load_layer", s.info_file),
-          info_at(s.info, "support_layer", s.info_file)));
-  s.curve = post::ReadLoadCurve((work / "scb_curve.txt").string());
-  s.r = post::AnalyseScb(
-      s.curve, info_at(s.info, "radius", s.info_file), info_at(s.info, "thickness", s.info_file),
-      info_at(s.info, "notch", s.info_file), info_at(s.info, "half_span", s.info_file));
-  s.peaked = s.r.peak_index + 1 < s.curve.size();
+  s.discs = std::move(discs);
+  const double n = static_cast<double>(s.discs.size());
+  for (const ScbDisc& d : s.discs) {
+    s.toughness += d.r.toughness / n;
+    s.peak_force += d.r.peak_force / n;
+    s.seconds += d.seconds;
+    s.peaked = s.peaked && d.peaked;
+  }
+  if (s.discs.size() > 1) {
+    double ss = 0;
+    for (const ScbDisc& d : s.discs)
+      ss += (d.r.toughness - s.toughness) * (d.r.toughness - s.toughness);
+    s.toughness_sem = std::sqrt(ss / (n - 1) / n);
+  }
   return s;
+}
+
+std::string ScbRun::summary() const {
+  if (discs.size() == 1) return fmt::format("{:.3f} MPa m^0.5 (one half disc)", toughness / 1e6);
+  const auto [lo, hi] = std::minmax_element(
+      discs.begin(), discs.end(),
+      [](const ScbDisc& a, const ScbDisc& b) { return a.r.toughness < b.r.toughness; });
+  return fmt::format("{:.3f} MPa m^0.5 +- {:.3f} ({:.3f}-{:.3f} over {} half discs)",
+                     toughness / 1e6, toughness_sem / 1e6, lo->r.toughness / 1e6,
+                     hi->r.toughness / 1e6, discs.size());
 }
 
 }  // namespace mill::calibrate

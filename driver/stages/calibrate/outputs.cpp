@@ -27,7 +27,7 @@ nlohmann::json macro(const Iteration& it) {
                    {"poisson_ratio", it.ucs.r.poisson_ratio},
                    {"ucs", it.ucs.r.ucs},
                    {"tensile_strength", it.br.r.tensile_strength}};
-  if (it.scb) m["fracture_toughness"] = it.scb->r.toughness;
+  if (it.scb) m["fracture_toughness"] = it.scb->toughness;
   return m;
 }
 
@@ -130,7 +130,7 @@ std::vector<std::string> Report::explain_missed() const {
         "pull too; at this element size (mean radius {:.2f} mm) the card's K_IC/tensile ratio of "
         "{:.3f} m^0.5 needs another sigma_b than its tensile strength does (docs/calibration.md, "
         "\"The toughness as a target\")",
-        b_.scb ? b_.scb->r.toughness / 1e6 : 0.0, 100 * b_.err_kic, t_.toughness / 1e6,
+        b_.scb ? b_.scb->toughness / 1e6 : 0.0, 100 * b_.err_kic, t_.toughness / 1e6,
         b_.p.tensile / 1e6, b_.p.cohesion / 1e6, sp_.mean_radius * 1e3, t_.toughness / t_.tensile));
   }
   if (b_.err_ucs > tol_) {
@@ -213,8 +213,17 @@ nlohmann::json Report::json() const {
     if (t_.toughness > 0) iters.back()["errors"]["fracture_toughness"] = it.err_kic;
     if (it.scb) {  // the bend test of the toughness fit
       nlohmann::json& j = iters.back();
-      j["scb_peak_force_N"] = it.scb->r.peak_force;
-      j["energy"]["scb"] = lab_energy_json(it.scb->energy);
+      j["scb_peak_force_N"] = it.scb->peak_force;
+      j["fracture_toughness_sem_Pa_m0.5"] = it.scb->toughness_sem;
+      nlohmann::json discs = nlohmann::json::array();
+      for (const ScbDisc& d : it.scb->discs)
+        discs.push_back({{"run", d.tag},
+                         {"angle_deg", d.angle_deg},
+                         {"fracture_toughness_Pa_m0.5", d.r.toughness},
+                         {"peaked", d.peaked}});
+      j["scb_discs"] = discs;
+      j["energy"]["scb"] = nlohmann::json::array();
+      for (const ScbDisc& d : it.scb->discs) j["energy"]["scb"].push_back(lab_energy_json(d.energy));
       j["wall_seconds"] = j["wall_seconds"].get<double>() + it.scb->seconds;
     }
   }
@@ -302,7 +311,7 @@ std::string Report::yaml() const {
   y << YAML::Key << "youngs_modulus" << YAML::Value << b_.ucs.r.youngs_modulus << YAML::Key
     << "poisson_ratio" << YAML::Value << b_.ucs.r.poisson_ratio << YAML::Key << "ucs" << YAML::Value
     << b_.ucs.r.ucs << YAML::Key << "tensile_strength" << YAML::Value << b_.br.r.tensile_strength;
-  if (b_.scb) y << YAML::Key << "fracture_toughness" << YAML::Value << b_.scb->r.toughness;
+  if (b_.scb) y << YAML::Key << "fracture_toughness" << YAML::Value << b_.scb->toughness;
   y << YAML::EndMap;
   y << YAML::Key << "specimen" << YAML::Value << YAML::BeginMap;
   y << YAML::Key << "elements" << YAML::Value << n_;
@@ -340,9 +349,10 @@ std::string Report::markdown() const {
                     b_.err_t <= tol_ ? "yes" : "no");
   if (t_.toughness > 0 && b_.scb)
     md << fmt::format(
-        "| K_IC (MPa m^0.5; semi-circular bend) | {:.3f} | {:.3f} | {:.1f}% | {:.0f}% | "
-        "{} |\n",
-        t_.toughness / 1e6, b_.scb->r.toughness / 1e6, 100 * b_.err_kic, 100 * tol_,
+        "| K_IC (MPa m^0.5; semi-circular bend, mean of {} half discs +- its standard error) | "
+        "{:.3f} | {:.3f} +- {:.3f} | {:.1f}% | {:.0f}% | {} |\n",
+        b_.scb->discs.size(), t_.toughness / 1e6, b_.scb->toughness / 1e6,
+        b_.scb->toughness_sem / 1e6, 100 * b_.err_kic, 100 * tol_,
         b_.err_kic <= tol_ ? "yes" : "no");
   md << "\n";
   md << "## Bond parameters (calibrated.yaml)\n\n| parameter | value |\n|---|---|\n";
@@ -373,7 +383,7 @@ std::string Report::markdown() const {
         it.ucs.r.poisson_ratio, it.ucs.r.ucs / 1e6, it.br.r.tensile_strength / 1e6,
         it.ucs.r.ucs / it.br.r.tensile_strength,
         !kic     ? std::string()
-        : it.scb ? fmt::format("{:.3f} | ", it.scb->r.toughness / 1e6)
+        : it.scb ? fmt::format("{:.3f} | ", it.scb->toughness / 1e6)
                  : std::string("- | "),
         it.ucs.seconds + it.br.seconds + (it.scb ? it.scb->seconds : 0.0));
   }
