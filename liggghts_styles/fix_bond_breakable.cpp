@@ -125,7 +125,8 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
       fail("keyword '" + key + "' is one of fix bond/breakable's parallel bonds; a flat joint " +
            "has none (its elements carry the moments, broken elements stay as frictional " +
            "contacts): remove it (docs/styles/fix_bond_flatjoint.md)");
-    } else if ((key == "elements" || key == "joint_friction") && !flat_joint_) {
+    } else if ((key == "elements" || key == "joint_friction" || key == "softening") &&
+               !flat_joint_) {
       fail("keyword '" + key + "' belongs to fix bond/flatjoint, not to " + style);
     } else if (key == "elements") {
       if (iarg + 2 >= narg) fail("keyword 'elements' needs two values: rings sectors");
@@ -136,6 +137,12 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
     } else if (key == "joint_friction") {
       fj_friction_ = args.real(arg[iarg], val);
       if (!(fj_friction_ >= 0.0)) fail("joint_friction must be >= 0, got " + std::string(val));
+    } else if (key == "softening") {
+      fj_softening_ = args.real(arg[iarg], val);
+      if (!(fj_softening_ >= 1.0))
+        fail("softening must be >= 1 (1: brittle elements; lambda > 1: tension falls to zero "
+             "at lambda x the peak opening), got " +
+             std::string(val));
     } else if (key == "radius_multiplier") {
       radius_multiplier_ = args.positive(arg[iarg], val);
     } else if (key == "modulus") {
@@ -195,7 +202,7 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
       fail("unknown keyword '" + key +
            (flat_joint_ ? "' (expected radius_multiplier, modulus, stiffness_ratio, "
                           "tensile_strength, cohesion, friction_angle, elements, joint_friction, "
-                          "unbonded_fraction, unbonded_seed, damping, gap, max_bonds, break_log, "
+                          "softening, unbonded_fraction, unbonded_seed, damping, gap, max_bonds, break_log, "
                           "dump_bonds)"
                         : "' (expected radius_multiplier, modulus, stiffness_ratio, "
                           "tensile_strength, cohesion, friction_angle, moment_factor, "
@@ -838,6 +845,7 @@ void FixBondBreakable::evaluate_flat_joint(const AtomArrays &at, ListedBond &bon
   p.cohesion = cohesion_;
   p.tan_phi = tan_friction_;
   p.mu = fj_friction_ >= 0.0 ? fj_friction_ : tan_friction_;
+  p.softening = fj_softening_;
   const mill::flat_joint::Result r = mill::flat_joint::update(bond.fj, fj_layout_, p, st);
   // Optional dashpots on the interface while it holds (as a parallel bond's:
   // on the contact point's relative velocity, not part of the stresses).

@@ -97,6 +97,7 @@ class FixBondBreakable : public Fix {
   bool flat_joint_ = false;
   int fj_rings_ = 1, fj_sectors_ = 3;  // elements: rings x sectors
   double fj_friction_ = -1.0;          // mu of broken elements (< 0: tan(friction_angle))
+  double fj_softening_ = 1.0;          // tension softening lambda = u_s / u_t (1: brittle)
   mill::flat_joint::Layout fj_layout_;
   int ncol_ = NCOL;  // columns of a slot
 

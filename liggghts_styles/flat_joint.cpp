@@ -139,6 +139,9 @@ Result update(double *h, const Layout &lay, const Params &p, const Step &s) {
   const double kn = p.kn, kna_all = kn * area, ksa_all = p.ks * area;
   const double cohesion = p.cohesion, tan_phi = p.tan_phi, tensile = p.tensile, mu = p.mu;
   const double stretch = s.stretch, gap0 = s.gap0;
+  // Tension softening: from u_t = sigma_c / kn to u_s = lambda u_t (lambda = 1: brittle).
+  const bool softens = p.softening > 1.0;
+  const double u_t = tensile / kn, u_s = p.softening * u_t;
   const bool advance = s.advance;
   const double *px = lay.px.data(), *py = lay.py.data(), *pa = lay.area.data();
   const double *inv_a = lay.inv_area.data();
@@ -196,9 +199,27 @@ Result update(double *h, const Layout &lay, const Params &p, const Step &s) {
     double normal = kna * u;
     bool broke = false;
     ElementLoad before;
-    const bool bonded = el[kState] == 0.0;
+    const double damage = el[kState];  // 0 intact, 1 broken, between: softened
+    const bool bonded = damage < 1.0;
+    double keep = 1.0;  // 1 - D of a softened element opened in tension, else 1
+    if (softens && bonded && u > 0.0) {
+      double d = damage;
+      if (advance && u > u_t && u < u_s) {
+        // On the envelope sigma_c (u_s - u) / (u_s - u_t): the secant's damage.
+        const double d_env = 1.0 - tensile * (u_s - u) / ((u_s - u_t) * kn * u);
+        if (d_env > d) {
+          // At this opening the element held (1 - d) kn A_e u^2 / 2 and now
+          // holds (1 - d_env) of it: the difference is dissipated.
+          out.released += 0.5 * kna * u * u * (d_env - d);
+          el[kState] = d_env;
+          d = d_env;
+        }
+      }
+      keep = 1.0 - d;
+      normal *= keep;
+    }
     if (bonded) {
-      const double sigma = kn * u;                         // N_e / A_e
+      const double sigma = keep * kn * u;                  // N_e / A_e
       const double strength = cohesion - sigma * tan_phi;  // Mohr-Coulomb, tension > 0
       // tau > tau_c  <=>  |S|^2 > (tau_c A_e)^2 for tau_c > 0; always for
       // tau_c < 0; for tau_c = 0 once any shear is left.
@@ -209,7 +230,7 @@ Result update(double *h, const Layout &lay, const Params &p, const Step &s) {
       shear_sq_e[checked] = s_sq;
       strength_e[checked++] = strength;
       const bool shear_fails = strength > 0.0 ? s_sq > lim_sq : strength < 0.0 || s_sq > 0.0;
-      if (advance && sigma > tensile) {
+      if (advance && (softens ? u >= u_s : sigma > tensile)) {
         ++out.broke_tension;
         broke = true;
       } else if (advance && shear_fails) {
@@ -256,14 +277,15 @@ Result update(double *h, const Layout &lay, const Params &p, const Step &s) {
                           (before.s2 - load.s2) * t2;
         const Vec3 v_e = s.vrel + cross(s.wrel, r);
         out.released +=
-            before.energy(kna, ksa) - load.energy(kna, ksa) + 0.5 * s.dt * dot(gone, v_e);
+            before.energy(kna * keep, ksa) - load.energy(kna, ksa) + 0.5 * s.dt * dot(gone, v_e);
       }
     }
     if (advance) {
       el[kShear] = s1;
       el[kShear + 1] = s2;
     }
-    sum_n += normal * normal * inv_a[e];
+    // A softened element opened in tension stores N^2 / (2 (1 - D) kn A_e).
+    sum_n += normal * normal * inv_a[e] / keep;
     sum_s += (s1 * s1 + s2 * s2) * inv_a[e];
     f1 += s1;
     f2 += s2;

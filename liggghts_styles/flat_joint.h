@@ -60,6 +60,14 @@ struct Params {
   double cohesion = 0;  // c, cohesion of a bonded element [Pa]
   double tan_phi = 0;   // tan of the bonded elements' friction angle [-]
   double mu = 0;        // friction coefficient of broken elements [-]
+  // Tension softening (a cohesive law, Hillerborg et al. 1976): 1 is brittle
+  // (an element breaks at sigma_c). lambda > 1: past the opening
+  // u_t = sigma_c / kn an element's tension falls linearly to zero at
+  // u_s = lambda u_t, where it breaks; below that envelope it unloads and
+  // reloads along its secant (damage D, stiffness (1 - D) kn in tension,
+  // kn in compression). Its fracture energy is lambda sigma_c^2 / (2 kn)
+  // per unit area, lambda times the brittle element's.
+  double softening = 1.0;
 };
 
 // History of one interface, kept by the caller: a reference axis t1 in the
@@ -72,7 +80,8 @@ inline constexpr int kT1 = 0;      // 3: t1, unit, normal to kNormal
 inline constexpr int kNormal = 3;  // 3: the unit normal t1 was last carried onto
 inline constexpr int kBend = 6;    // 2: theta_b . t1, theta_b . t2 [rad]
 inline constexpr int kHistory = 8;
-inline constexpr int kState = 0;  // per element, at kHistory + 3 e: 0 bonded, 1 broken
+inline constexpr int kState = 0;  // per element, at kHistory + 3 e: 0 bonded, 1 broken;
+                                  // between: bonded, softened to damage D (Params::softening)
 inline constexpr int kShear = 1;  // 2: shear force on b along t1, t2 [N]
 inline int history_size(int elements) { return kHistory + 3 * elements; }
 
@@ -107,7 +116,8 @@ struct Result {
   Vec3 moment_b;  // moment on b about the contact point (on a: minus it) [N m]
   double energy = 0;    // elastic energy stored in the elements [J]
   double slipped = 0;   // taken by Coulomb slip this step [J]
-  double released = 0;  // stored in elements that broke this step [J]
+  double released = 0;  // stored in elements that broke this step, and what softening
+                        // elements dissipated in it [J]
   int bonded = 0;       // bonded elements after the step
   int broke_tension = 0, broke_shear = 0;  // elements that broke this step
   // Over the elements bonded at the start of the step (those that broke in

@@ -312,6 +312,84 @@ TEST(FlatJoint, WorkOfALoadingPathIsTheStoredEnergy) {
   EXPECT_LT(std::fabs(work), 1e-6 * loaded);
 }
 
+// Tension softening (Params::softening = lambda, flat_joint.h): a slow
+// uniform pull of an interface follows the linear cohesive envelope, peak
+// sigma_c A at u_t = sigma_c / kn, then sigma_c A (u_s - u) / (u_s - u_t)
+// down to zero at u_s = lambda u_t, where every element breaks; the work of
+// the whole pull, lambda sigma_c^2 A / (2 kn) (the envelope's area), is
+// what the elements released (1e-3: the trapezoid rule over 20 000 steps),
+// and at every step work = stored + released (energy conservation, 1e-3).
+TEST(FlatJoint, SofteningPullFollowsTheCohesiveEnvelope) {
+  Params p = sandstone();
+  p.softening = 4.0;
+  const Layout lay = make_layout(1, 3);
+  const double area = kPi * kR * kR, u_t = p.tensile / p.kn, u_s = p.softening * u_t;
+  auto h = fresh(lay);
+  const int steps = 20000;
+  const double du = 1.05 * u_s / steps;
+  double work = 0, released = 0, f_prev = 0, peak = 0;
+  int broke_at = -1;
+  for (int k = 1; k <= steps; ++k) {
+    const double u = k * du;
+    const Result r = update(h.data(), lay, p, step(u));
+    const double f = -dot(r.force_b, kN);  // tension on the interface
+    work += 0.5 * (f_prev + f) * du;
+    released += r.released;
+    f_prev = f;
+    peak = std::max(peak, f);
+    const double f_env = u <= u_t ? p.kn * area * u
+                         : u < u_s ? p.tensile * area * (u_s - u) / (u_s - u_t)
+                                   : 0.0;
+    ASSERT_NEAR(f, f_env, 1e-9 * p.tensile * area) << "u / u_t " << u / u_t;
+    if (u < u_s) {
+      ASSERT_EQ(r.broke_tension, 0) << u / u_t;
+      ASSERT_EQ(r.bonded, lay.elements());
+      ASSERT_NEAR(work, r.energy + released, 1e-3 * p.tensile * area * u_s) << u / u_t;
+    } else if (broke_at < 0) {
+      broke_at = k;
+      EXPECT_EQ(r.broke_tension, lay.elements());
+    }
+  }
+  EXPECT_NEAR(peak / (p.tensile * area), 1.0, 1e-3);
+  EXPECT_GT(broke_at, 0);
+  const double fracture = 0.5 * p.tensile * area * u_s;  // lambda sigma_c^2 A / (2 kn)
+  EXPECT_NEAR(fracture, p.softening * p.tensile * p.tensile * area / (2.0 * p.kn), 1e-12 * fracture);
+  EXPECT_NEAR(work / fracture, 1.0, 1e-3);
+  EXPECT_NEAR(released / fracture, 1.0, 1e-3);
+}
+
+// Below the envelope a softened element unloads and reloads along its
+// secant, (1 - D) kn, with D = 1 - sigma_env(u_max) / (kn u_max), storing
+// (1 - D) kn A u^2 / 2 and releasing nothing; it takes compression with the
+// intact kn; reloaded, it meets the envelope where it left it (1e-12).
+TEST(FlatJoint, SoftenedElementUnloadsAlongItsSecant) {
+  Params p = sandstone();
+  p.softening = 3.0;
+  const Layout lay = make_layout(1, 4);
+  const double area = kPi * kR * kR, u_t = p.tensile / p.kn, u_s = p.softening * u_t;
+  auto h = fresh(lay);
+  const double u_max = 2.0 * u_t;  // half way down the envelope
+  for (int k = 1; k <= 100; ++k) update(h.data(), lay, p, step(k * u_max / 100));
+  const double f_env = p.tensile * area * (u_s - u_max) / (u_s - u_t);
+  const double secant = f_env / u_max;  // (1 - D) kn A
+  for (double frac : {0.75, 0.5, 0.25}) {
+    const Result r = update(h.data(), lay, p, step(frac * u_max));
+    EXPECT_NEAR(-dot(r.force_b, kN) / (secant * frac * u_max), 1.0, 1e-12) << frac;
+    EXPECT_NEAR(r.energy / (0.5 * secant * std::pow(frac * u_max, 2)), 1.0, 1e-12) << frac;
+    EXPECT_EQ(r.released, 0.0) << frac;
+  }
+  const Result c = update(h.data(), lay, p, step(-0.1 * u_t));  // compression: intact kn
+  EXPECT_NEAR(dot(c.force_b, kN) / (p.kn * area * 0.1 * u_t), 1.0, 1e-12);
+  const Result back = update(h.data(), lay, p, step(u_max));
+  EXPECT_NEAR(-dot(back.force_b, kN) / f_env, 1.0, 1e-12);
+  EXPECT_EQ(back.released, 0.0);
+  EXPECT_EQ(back.bonded, lay.elements());
+  // lambda = 1 is the brittle element: it breaks just past u_t.
+  p.softening = 1.0;
+  auto hb = fresh(lay);
+  EXPECT_EQ(update(hb.data(), lay, p, step(1.001 * u_t)).broke_tension, lay.elements());
+}
+
 // The frame's small turns take their sin and cos from a Taylor series below
 // kSeriesTurn (flat_joint.h: truncation error < 2e-22 relative there): it
 // agrees with the library's sin and cos to round-off at every angle a step
