@@ -201,7 +201,7 @@ Result update(double *h, const Layout &lay, const Params &p, const Step &s) {
     ElementLoad before;
     const double damage = el[kState];  // 0 intact, 1 broken, between: softened
     const bool bonded = damage < 1.0;
-    double keep = 1.0;  // 1 - D of a softened element opened in tension, else 1
+    double keep = 1.0, inv_keep = 1.0;  // 1 - D of a softened element opened in tension, else 1
     if (softens && bonded && u > 0.0) {
       double d = damage;
       if (advance && u > u_t && u < u_s) {
@@ -216,6 +216,7 @@ Result update(double *h, const Layout &lay, const Params &p, const Step &s) {
         }
       }
       keep = 1.0 - d;
+      inv_keep = 1.0 / keep;  // only here: no division per element otherwise
       normal *= keep;
     }
     if (bonded) {
@@ -285,7 +286,7 @@ Result update(double *h, const Layout &lay, const Params &p, const Step &s) {
       el[kShear + 1] = s2;
     }
     // A softened element opened in tension stores N^2 / (2 (1 - D) kn A_e).
-    sum_n += normal * normal * inv_a[e] / keep;
+    sum_n += normal * normal * inv_a[e] * inv_keep;
     sum_s += (s1 * s1 + s2 * s2) * inv_a[e];
     f1 += s1;
     f2 += s2;
