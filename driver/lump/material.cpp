@@ -14,6 +14,19 @@ namespace fs = std::filesystem;
 
 std::string ore_hash(const config::Document& ore) { return jobs::job_id(config::ore_keys(ore)); }
 
+bool fits_toughness(const config::CaseConfig& cfg) {
+  return cfg.doc.boolean("calibrate.fit_toughness") &&
+         estimate_bond_params(cfg.ore, cfg.doc).model == BondModel::flat_joint &&
+         cfg.ore.has("fracture_toughness");
+}
+
+std::string calibration_hash(const config::CaseConfig& cfg) {
+  if (!fits_toughness(cfg)) return ore_hash(cfg.ore);
+  nlohmann::json keys = config::ore_keys(cfg.ore);
+  keys["fracture_toughness"] = cfg.ore.real("fracture_toughness");
+  return jobs::job_id(keys);
+}
+
 BondParams estimate_bond_params(const config::Document& ore, const config::Document& doc) {
   // Starting point only; `--stage calibrate` replaces it. Potyondy & Cundall
   // (2004, sec. 3 and table 1) report macro E close to the bond modulus for
@@ -70,7 +83,7 @@ bool read_calibrated_file(const fs::path& file, const std::string& hash, BondPar
 
 BondParams bond_params_for(const config::CaseConfig& cfg, const fs::path& run_dir) {
   BondParams b = estimate_bond_params(cfg.ore, cfg.doc);
-  const std::string hash = ore_hash(cfg.ore);
+  const std::string hash = calibration_hash(cfg);
   BondParams c = b;
   if (read_calibrated_file(run_dir / "calibrate" / "calibrated.yaml", hash, c)) return c;
   if (read_calibrated_file(cfg.ore_file, hash, c)) return c;
@@ -85,7 +98,7 @@ BondParams bond_params_for_set(const config::CaseConfig& cfg, const fs::path& ru
   if (k <= 1) return bond_params_for(cfg, run_dir);
   BondParams c = estimate_bond_params(cfg.ore, cfg.doc);
   const fs::path f = set_calibration_file(run_dir, k);
-  if (!read_calibrated_file(f, ore_hash(cfg.ore), c))
+  if (!read_calibrated_file(f, calibration_hash(cfg), c))
     throw std::runtime_error(fmt::format(
         "{}: no calibration of start {} fitted to this ore card with the case's bond model "
         "({}); run `orchestrate --stage calibrate` with calibrate.starts >= {}",

@@ -16,6 +16,17 @@ namespace mill {
 // Hash of an ore card's macro properties (what a calibration was fitted to).
 std::string ore_hash(const config::Document& ore);
 
+// True when the flat joint's fit aims at the card's K_IC too
+// (calibrate.fit_toughness, lump.bond_model flat_joint, the card gives
+// fracture_toughness): docs/calibration.md, "The toughness as a target".
+bool fits_toughness(const config::CaseConfig& cfg);
+
+// The input_hash that ties a calibration to what it was fitted to: the
+// card's macro properties (ore_hash), and its fracture_toughness when the
+// fit aimed at it (fits_toughness), so that a section fitted to another
+// K_IC is not taken for this card's.
+std::string calibration_hash(const config::CaseConfig& cfg);
+
 // Closed-form starting estimates of the micro parameters (docs/breakage.md),
 // with the case's bond model, its layout and radius multiplier (lump.*).
 BondParams estimate_bond_params(const config::Document& ore, const config::Document& doc);

@@ -38,15 +38,6 @@ using namespace calibrate;
 // local linear model (calibrate/local_model.h) instead of one secant each.
 constexpr int kDeckVersion = 6;
 
-// True when the fit aims at the card's K_IC too (calibrate.fit_toughness,
-// flat joints, the card gives fracture_toughness): docs/calibration.md,
-// "The toughness as a target".
-bool fits_toughness(const config::CaseConfig& cfg) {
-  return cfg.doc.boolean("calibrate.fit_toughness") &&
-         estimate_bond_params(cfg.ore, cfg.doc).model == BondModel::flat_joint &&
-         cfg.ore.has("fracture_toughness");
-}
-
 // The fit's targets: the card's four macro properties, and its K_IC when
 // the fit aims at it.
 Targets targets_of(const config::CaseConfig& cfg) {
@@ -69,7 +60,7 @@ bool card_calibration_fits_model(const config::CaseConfig& cfg) {
 // properties (same input_hash).
 bool card_is_calibrated(const config::CaseConfig& cfg) {
   return card_calibration_fits_model(cfg) &&
-         cfg.ore.str(std::string(kCalibratedSection) + "." + kInputHashKey) == ore_hash(cfg.ore);
+         cfg.ore.str(std::string(kCalibratedSection) + "." + kInputHashKey) == calibration_hash(cfg);
 }
 
 // True when the card carries such a section fitted to other properties (a

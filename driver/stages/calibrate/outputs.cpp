@@ -66,7 +66,7 @@ class Report {
         half_(o.half),
         wall_(o.wall),
         notes_(o.notes),
-        hash_(ore_hash(cfg.ore)),
+        hash_(calibration_hash(cfg)),
         rate_change_(o.half ? post::RelativeError(o.half->r.ucs, b_.ucs.r.ucs) : 0.0),
         rate_ok_(rate_change_ < 0.05),
         noise_(sensitivity_noise(b_.ucs, o.half ? &*o.half : nullptr)),
@@ -496,7 +496,7 @@ void write_outputs(StageContext& ctx, const fs::path& dir, const Fitting& fit, c
 // The card's own calibrated.* section, copied (no fitting).
 void copy_from_card(StageContext& ctx, const fs::path& dir) {
   const auto& o = ctx.cfg.ore;
-  const std::string hash = ore_hash(o);
+  const std::string hash = calibration_hash(ctx.cfg);
   YAML::Emitter y;
   y.SetDoublePrecision(8);
   y << YAML::BeginMap;
