@@ -59,8 +59,8 @@ bool card_calibration_fits_model(const config::CaseConfig& cfg) {
 // True when the ore card carries such a section fitted to its own macro
 // properties (same input_hash).
 bool card_is_calibrated(const config::CaseConfig& cfg) {
-  return card_calibration_fits_model(cfg) &&
-         cfg.ore.str(std::string(kCalibratedSection) + "." + kInputHashKey) == calibration_hash(cfg);
+  return card_calibration_fits_model(cfg) && cfg.ore.str(std::string(kCalibratedSection) + "." +
+                                                         kInputHashKey) == calibration_hash(cfg);
 }
 
 // True when the card carries such a section fitted to other properties (a

@@ -26,9 +26,9 @@ mill::config::CaseConfig with_card(const fs::path& dir, double kic, const std::s
   std::ifstream in(kProject / "liggghts_inputs" / "materials" / "sandstone.yaml");
   std::stringstream card;
   card << in.rdbuf();
-  const std::string text = std::regex_replace(
-      card.str(), std::regex("fracture_toughness: [0-9.e+]+"),
-      "fracture_toughness: " + std::to_string(kic));
+  const std::string text =
+      std::regex_replace(card.str(), std::regex("fracture_toughness: [0-9.e+]+"),
+                         "fracture_toughness: " + std::to_string(kic));
   std::ofstream(dir / "card.yaml") << text;
   std::ofstream(dir / "case.yaml") << "name: h\nore: {card: card.yaml}\nlump: " << lump << "\n"
                                    << calibrate;
