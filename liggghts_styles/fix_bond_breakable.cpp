@@ -140,9 +140,10 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
     } else if (key == "softening") {
       fj_softening_ = args.real(arg[iarg], val);
       if (!(fj_softening_ >= 1.0))
-        fail("softening must be >= 1 (1: brittle elements; lambda > 1: tension falls to zero "
-             "at lambda x the peak opening), got " +
-             std::string(val));
+        fail(
+            "softening must be >= 1 (1: brittle elements; lambda > 1: tension falls to zero "
+            "at lambda x the peak opening), got " +
+            std::string(val));
     } else if (key == "radius_multiplier") {
       radius_multiplier_ = args.positive(arg[iarg], val);
     } else if (key == "modulus") {
@@ -199,15 +200,17 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
         iarg += 2;
       }
     } else {
-      fail("unknown keyword '" + key +
-           (flat_joint_ ? "' (expected radius_multiplier, modulus, stiffness_ratio, "
-                          "tensile_strength, cohesion, friction_angle, elements, joint_friction, "
-                          "softening, unbonded_fraction, unbonded_seed, damping, gap, max_bonds, break_log, "
-                          "dump_bonds)"
-                        : "' (expected radius_multiplier, modulus, stiffness_ratio, "
-                          "tensile_strength, cohesion, friction_angle, moment_factor, "
-                          "broken_contact, contact_moment, unbonded_fraction, unbonded_seed, "
-                          "damping, gap, max_bonds, break_log, dump_bonds)"));
+      fail(
+          "unknown keyword '" + key +
+          (flat_joint_
+               ? "' (expected radius_multiplier, modulus, stiffness_ratio, "
+                 "tensile_strength, cohesion, friction_angle, elements, joint_friction, "
+                 "softening, unbonded_fraction, unbonded_seed, damping, gap, max_bonds, break_log, "
+                 "dump_bonds)"
+               : "' (expected radius_multiplier, modulus, stiffness_ratio, "
+                 "tensile_strength, cohesion, friction_angle, moment_factor, "
+                 "broken_contact, contact_moment, unbonded_fraction, unbonded_seed, "
+                 "damping, gap, max_bonds, break_log, dump_bonds)"));
     }
     iarg += 2;
   }

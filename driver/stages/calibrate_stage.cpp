@@ -179,8 +179,7 @@ void Calibration::run() {
         "{:.2f} MPa ({:.2f}){}{} [{:.0f} s + {:.0f} s{}]",
         k, max_it_, it.ucs.r.youngs_modulus / 1e9, t.E / 1e9, it.ucs.r.poisson_ratio, t.nu,
         it.ucs.r.ucs / 1e6, t.ucs / 1e6, it.br.r.tensile_strength / 1e6, t.tensile / 1e6,
-        it.scb ? fmt::format(", K_IC {} ({:.3f})", it.scb->summary(), t.toughness / 1e6)
-               : "",
+        it.scb ? fmt::format(", K_IC {} ({:.3f})", it.scb->summary(), t.toughness / 1e6) : "",
         it.converged ? ": all within tolerance" : "", it.ucs.seconds, it.br.seconds,
         it.scb ? fmt::format(" + {:.0f} s", it.scb->seconds) : ""));
     if (it.scb && !it.scb->peaked)
@@ -217,11 +216,10 @@ void Calibration::run() {
     }
   }
   if (primary)
-    o.checks =
-        run_checks(lab, hist[o.best].p, hist[o.best].ucs, rate_,
-                   confining_pressures(d_, hist[o.best].ucs.r.ucs), check_for,
-                   (per_it * max_it_ + 2.0 + n_sensitivity) / steps_total, 1.0 / steps_total,
-                   scb_orientations_, hist[o.best].scb ? &*hist[o.best].scb : nullptr);
+    o.checks = run_checks(lab, hist[o.best].p, hist[o.best].ucs, rate_,
+                          confining_pressures(d_, hist[o.best].ucs.r.ucs), check_for,
+                          (per_it * max_it_ + 2.0 + n_sensitivity) / steps_total, 1.0 / steps_total,
+                          scb_orientations_, hist[o.best].scb ? &*hist[o.best].scb : nullptr);
   o.checks.toughness_fitted = fit_.fits_toughness();
   o.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_outputs(ctx_, dir_, fit_, o);

@@ -27,8 +27,8 @@ ScbDisc disc(double kic, double force, double seconds, bool peaked) {
 // Three discs 0.3, 0.4, 0.5 MPa m^0.5: mean 0.4, sample standard deviation
 // 0.1, standard error 0.1 / sqrt(3) (to 1e-12 relative).
 TEST(ScbDiscs, MeanAndStandardErrorOfThreeDiscs) {
-  const ScbRun s = ScbRun::of(
-      {disc(0.3e6, 100, 2, true), disc(0.4e6, 130, 3, true), disc(0.5e6, 160, 1, true)});
+  const ScbRun s =
+      ScbRun::of({disc(0.3e6, 100, 2, true), disc(0.4e6, 130, 3, true), disc(0.5e6, 160, 1, true)});
   EXPECT_NEAR(s.toughness, 0.4e6, 1e-12 * 0.4e6);
   EXPECT_NEAR(s.toughness_sem, 0.1e6 / std::sqrt(3.0), 1e-12 * 0.1e6);
   EXPECT_NEAR(s.peak_force, 130, 1e-12 * 130);

@@ -337,7 +337,7 @@ TEST(FlatJoint, SofteningPullFollowsTheCohesiveEnvelope) {
     released += r.released;
     f_prev = f;
     peak = std::max(peak, f);
-    const double f_env = u <= u_t ? p.kn * area * u
+    const double f_env = u <= u_t  ? p.kn * area * u
                          : u < u_s ? p.tensile * area * (u_s - u) / (u_s - u_t)
                                    : 0.0;
     ASSERT_NEAR(f, f_env, 1e-9 * p.tensile * area) << "u / u_t " << u / u_t;
@@ -353,7 +353,8 @@ TEST(FlatJoint, SofteningPullFollowsTheCohesiveEnvelope) {
   EXPECT_NEAR(peak / (p.tensile * area), 1.0, 1e-3);
   EXPECT_GT(broke_at, 0);
   const double fracture = 0.5 * p.tensile * area * u_s;  // lambda sigma_c^2 A / (2 kn)
-  EXPECT_NEAR(fracture, p.softening * p.tensile * p.tensile * area / (2.0 * p.kn), 1e-12 * fracture);
+  EXPECT_NEAR(fracture, p.softening * p.tensile * p.tensile * area / (2.0 * p.kn),
+              1e-12 * fracture);
   EXPECT_NEAR(work / fracture, 1.0, 1e-3);
   EXPECT_NEAR(released / fracture, 1.0, 1e-3);
 }

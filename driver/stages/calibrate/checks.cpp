@@ -208,8 +208,8 @@ std::string checks_markdown(const Checks& c, double ucs_peak) {
   if (!c.envelope_error.empty()) md << "Not fitted: " << c.envelope_error << ".";
   md << "\n";
   if (c.scb)
-    md << fmt::format("\nSemi-circular bend: mean peak {:.1f} N, K_IC {}{}.\n",
-                      c.scb->peak_force, c.scb->summary(),
+    md << fmt::format("\nSemi-circular bend: mean peak {:.1f} N, K_IC {}{}.\n", c.scb->peak_force,
+                      c.scb->summary(),
                       c.scb->peaked ? "" : " (a half disc reached its cap still loading)");
   md << "\n| property | ore card | achieved | error |\n|---|---|---|---|\n";
   md << compared_row("friction angle (deg)", c.targets.friction_angle_deg,

@@ -152,17 +152,16 @@ TriaxialRun LabBench::triaxial(const BondParams& p, double rate, double pressure
 // far: bending is more compliant.
 ScbRun LabBench::scb(const BondParams& p, double rate, int orientations, const RunStep& step) {
   if (orientations < 1)
-    throw std::runtime_error(fmt::format(
-        "calibrate.scb_orientations: expected at least 1, got {}", orientations));
+    throw std::runtime_error(
+        fmt::format("calibrate.scb_orientations: expected at least 1, got {}", orientations));
   std::vector<ScbDisc> discs;
   for (int k = 0; k < orientations; ++k) {
     ScbDisc d;
     d.angle_deg = 180.0 * k / orientations;
-    const RunStep disc_step{k == 0 ? step.tag : fmt::format("{}_o{}", step.tag, k),
-                            orientations == 1
-                                ? step.what
-                                : fmt::format("{} {}/{}", step.what, k + 1, orientations),
-                            step.done};
+    const RunStep disc_step{
+        k == 0 ? step.tag : fmt::format("{}_o{}", step.tag, k),
+        orientations == 1 ? step.what : fmt::format("{} {}/{}", step.what, k + 1, orientations),
+        step.done};
     const fs::path work = run_test({"scb",
                                     kScbRadiusFactor * sp_.disc_r,
                                     4.0 * t_.tensile / t_.E,

@@ -223,7 +223,8 @@ nlohmann::json Report::json() const {
                          {"peaked", d.peaked}});
       j["scb_discs"] = discs;
       j["energy"]["scb"] = nlohmann::json::array();
-      for (const ScbDisc& d : it.scb->discs) j["energy"]["scb"].push_back(lab_energy_json(d.energy));
+      for (const ScbDisc& d : it.scb->discs)
+        j["energy"]["scb"].push_back(lab_energy_json(d.energy));
       j["wall_seconds"] = j["wall_seconds"].get<double>() + it.scb->seconds;
     }
   }
