@@ -9,7 +9,7 @@ PKGS="build-essential cmake pkg-config git
   libvtk9-dev libhdf5-dev
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev libgtest-dev
   slurm-wlm munge
-  python3 python3-matplotlib python3-numpy python3-h5py
+  python3 python3-matplotlib python3-numpy python3-h5py python3-pil
   chromium"
 # --no-install-recommends: openfoam recommends ParaView, whose python3-paraview
 # conflicts with python3-vtk9 (needed by libvtk9-dev); see docs/install.md.

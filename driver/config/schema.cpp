@@ -397,6 +397,11 @@ std::vector<KeyDef> breakage_keys() {
               "there within a chunk at its speed towards the axis), and every element whose "
               "latest flywheel contact came after its latest housing contact has left the "
               "housing (docs/breakage.md); false = every run lasts duration"),
+          key("breakage.in_mill.animate", T::Bool, "", "true",
+              "In-mill breakage: the first in-mill run (the first lump of the first rotor speed) "
+              "also writes 60 frames over duration, drawn as an animation in the report "
+              "(breakage/animation/, docs/report.md); false = none (that run keeps the job id "
+              "it had without the frames)"),
           at_least(key("breakage.in_mill.neighbour_bins", T::Int, "", "4000000",
                        "In-mill breakage: most neighbour bins over the simulation box, which holds "
                        "the whole mill "

@@ -76,6 +76,7 @@ std::string page_head(const std::string& title) {
          "table.headline tr.group th{background:#468;color:#fff}"
          "dl.numbers{display:grid;grid-template-columns:max-content auto;gap:2px 1em}dl.numbers dt{color:#555}"
          "dl.numbers dd{margin:0;font-weight:bold}"
+         "figure.strip{display:flex;gap:1%}figure.strip div{flex:1}figure.strip img{max-width:100%}"
          "details{margin:0.5em 0}summary{cursor:pointer;color:#468}"
          ".bad{color:#a00;border:1px solid #a00;padding:0.5em}</style></head><body>\n";
 }
@@ -85,8 +86,13 @@ std::string page_tail() {
 }
 
 void embed_png(std::ostringstream& o, const fs::path& f, const std::string& caption) {
-  o << "<figure><img alt=\"" << esc(caption) << "\" src=\"data:image/png;base64," << base64(slurp(f))
-    << "\"><figcaption>" << esc(caption) << "</figcaption></figure>\n";
+  embed_image(o, f, "image/png", caption);
+}
+
+void embed_image(std::ostringstream& o, const fs::path& f, const std::string& mime,
+                 const std::string& caption) {
+  o << "<figure><img alt=\"" << esc(caption) << "\" src=\"data:" << mime << ";base64,"
+    << base64(slurp(f)) << "\"><figcaption>" << esc(caption) << "</figcaption></figure>\n";
 }
 
 namespace {

@@ -47,6 +47,10 @@ std::string page_tail();
 // A figure with the PNG embedded as a data URI and its caption.
 void embed_png(std::ostringstream& o, const std::filesystem::path& png, const std::string& caption);
 
+// The same for an image of the given MIME type ("image/gif": an animation).
+void embed_image(std::ostringstream& o, const std::filesystem::path& file, const std::string& mime,
+                 const std::string& caption);
+
 // A JSON object as a two-column table (nested keys joined with dots): for
 // the folded raw-data parts of a page, never for a headline.
 void json_table(std::ostringstream& o, const nlohmann::json& j, const std::string& prefix = "");

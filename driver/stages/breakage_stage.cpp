@@ -17,6 +17,7 @@
 #include "stages/breakage/campaign.h"
 #include "stages/breakage/circuit.h"
 #include "stages/breakage/impact_runs.h"
+#include "stages/breakage/in_mill_animation.h"
 #include "stages/breakage/in_mill_runs.h"
 #include "stages/breakage/mill_product.h"
 #include "stages/breakage/summaries.h"
@@ -105,7 +106,7 @@ void write_population_balance(StageContext& ctx, const std::vector<JobSpec>& in_
 
 std::string BreakageStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
   const fs::path dir = jobs::JobStore(ctx.stage_dir).job_dir(job.label);
-  return is_in_mill_job(job) ? damaged_in_mill_outputs(dir) : damaged_impact_outputs(dir);
+  return is_in_mill_job(job) ? damaged_in_mill_outputs(job, dir) : damaged_impact_outputs(dir);
 }
 
 // The merged tables and summaries of the impacts (and the mill product of
@@ -145,6 +146,7 @@ std::string BreakageStage::damaged_merged_outputs(const StageContext& ctx,
   if (ctx.cfg.doc.str("breakage.conditions") == "transport") {
     r.push_back(jobs::check_file(dir / "product.csv"));
     r.push_back(jobs::check_json(dir / "product.json", true));
+    if (std::any_of(jobs.begin(), jobs.end(), is_animated)) r.push_back(damaged_animation(dir));
     if (ctx.cfg.feed && std::any_of(jobs.begin(), jobs.end(), is_in_mill_job)) {
       r.push_back(jobs::check_file(dir / "breakage_matrix.csv"));
       r.push_back(jobs::check_json(dir / "breakage_matrix.json", true));

@@ -46,7 +46,7 @@ std::vector<fs::path> report_inputs(const fs::path& run) {
       const std::string ext = p.extension().string();
       if (p.filename() == "stage.json") continue;  // the stage's bookkeeping, not a result
       if (it->is_regular_file() &&
-          (ext == ".png" || ext == ".json" || ext == ".csv" || ext == ".md"))
+          (ext == ".png" || ext == ".gif" || ext == ".json" || ext == ".csv" || ext == ".md"))
         files.push_back(p);
     }
   }
@@ -303,6 +303,55 @@ void impact_table(std::ostringstream& raw, const SectionInputs& in) {
   in.summary["breakage_impacts"] = impacts.size();
 }
 
+// True for the files of breakage/animation/ (drawn by animation_block).
+bool in_animation(const fs::path& f, const fs::path& run) {
+  const fs::path rel = fs::relative(f, run);
+  auto it = rel.begin();
+  return it != rel.end() && *it == "breakage" && ++it != rel.end() && *it == "animation";
+}
+
+// The in-mill animation (breakage/animation/, docs/report.md): the GIF with
+// a caption naming the lump, rotor speed and time span, then its first,
+// middle and last frame as stills.
+void animation_block(std::ostringstream& o, const SectionInputs& in) {
+  const fs::path dir = in.run / "breakage" / "animation";
+  if (!fs::is_directory(dir)) return;
+  const nlohmann::json j = report::read_json(dir / "animation.json", &in.problems);
+  if (!j.is_object()) {
+    if (!fs::exists(dir / "animation.json"))
+      in.problems.push_back({dir / "animation.json", "missing beside the animation's frames"});
+    return;
+  }
+  for (const char* f :
+       {"animation.gif", "animation_first.png", "animation_middle.png", "animation_last.png"})
+    if (!fs::exists(dir / f)) {
+      in.problems.push_back({dir / f, "missing: the in-mill animation is left out"});
+      return;
+    }
+  const std::string caption = fmt::format(
+      "{}. {} frames from t = {:.2f} to {:.2f} ms, one every {:.2f} ms; the elements (discs of "
+      "their radius) coloured by their intact bonds, the housing and the flywheel cut in the "
+      "plane of the rotor.",
+      j.value("caption", std::string("In-mill run")), j.value("frames", 0),
+      j.value("time_first_ms", 0.0), j.value("time_last_ms", 0.0),
+      j.value("frame_interval_ms", 0.0));
+  o << "<h3>One lump in the mill</h3>\n";
+  report::embed_image(o, dir / "animation.gif", "image/gif", caption);
+  o << "<figure class=strip>";
+  for (const char* s : {"first", "middle", "last"}) {
+    const auto& still = report::pick(report::pick(j, "stills"), s);
+    const std::string what = fmt::format("{} frame, t = {:.2f} ms", s,
+                                         still.is_object() ? still.value("time_ms", 0.0) : 0.0);
+    o << "<div><img alt=\"" << esc(what) << "\" src=\"data:image/png;base64,"
+      << report::base64(report::slurp(dir / fmt::format("animation_{}.png", s)))
+      << "\"><figcaption>" << esc(what) << "</figcaption></div>";
+  }
+  o << "</figure>\n<p class=note>Drawn from the run's frame dump by "
+       "<code>postprocess/plot_animation.py</code>; <code>breakage.in_mill.animate: false</code> "
+       "turns it off.</p>\n";
+  in.summary["in_mill_animation"] = j;
+}
+
 // One stage's section: figures first, then the stage's labelled numbers,
 // then the raw data folded; a note when the stage has not run.
 void stage_section(std::ostringstream& o, const std::string& stage, const std::string& title,
@@ -329,11 +378,12 @@ void stage_section(std::ostringstream& o, const std::string& stage, const std::s
   }
   std::vector<fs::path> pngs;
   for (const auto& f : mine)
-    if (f.extension() == ".png") pngs.push_back(f);
+    if (f.extension() == ".png" && !in_animation(f, in.run)) pngs.push_back(f);
   std::stable_sort(pngs.begin(), pngs.end(), [](const fs::path& a, const fs::path& b) {
     return figure_rank(a) < figure_rank(b);
   });
   for (const auto& f : pngs) embed_png(o, f, fs::relative(f, in.run).string());
+  if (stage == "breakage") animation_block(o, in);
   stage_numbers(o, in.rows, stage);
   if (stage == "breakage")
     size_table(o, report::read_json(in.run / "breakage" / "size_distributions.json", &in.problems));
@@ -384,7 +434,7 @@ Plan ReportStage::plan(const StageContext& ctx) const {
                   static_cast<long long>(st.st_mtime)});
   }
   p.jobs.push_back({"report",
-                    {{"inputs", in}, {"report_version", 4}},
+                    {{"inputs", in}, {"report_version", 5}},
                     "report/index.html and report/summary.json from every stage's outputs"});
   return p;
 }

@@ -9,11 +9,17 @@
 // rotor into the housing stops at the end of the first chunk after it has
 // reached the housing, well before the 8 ms; the struck lump's fragments are
 // still in the rotor region at 8 ms (they are struck again and again for
-// over 30 ms on this small mill), so it runs to the end.
+// over 30 ms on this small mill), so it runs to the end. The animation
+// (breakage.in_mill.animate, on by default): the first run of the plan
+// writes 60 frames over its 8 ms, drawn into breakage/animation/ and shown
+// in the report; the lump moves between its first and last frame.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -48,6 +54,38 @@ void write_transport_impacts(const fs::path& run) {
        std::string(kImpactsCsvHeader) +
            row(1, t, {-0.021, 0.62, 0}, {0, -5, 0}, {-0.01, 0.62, 0}, {-1, 0, 0}) +
            row(2, t, {0.2, 0.95, 0}, {60, 0, 0}, {0.2, 0.94, 0}, {0, 1, 0}));
+}
+
+// The snapshots of a `dump custom` text file: per snapshot, the mean x and
+// y of its elements (the columns named in its ITEM: ATOMS line).
+std::vector<std::array<double, 2>> dump_centroids(const fs::path& f) {
+  std::istringstream in(slurp(f));
+  std::vector<std::array<double, 2>> out;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("ITEM: NUMBER OF ATOMS", 0) != 0) continue;
+    std::getline(in, line);
+    const long n = std::stol(line);
+    while (std::getline(in, line) && line.rfind("ITEM: ATOMS", 0) != 0) {
+    }
+    std::istringstream head(line.substr(12));
+    std::vector<std::string> names;
+    for (std::string w; head >> w;) names.push_back(w);
+    const auto col = [&](const char* c) {
+      return std::find(names.begin(), names.end(), c) - names.begin();
+    };
+    const long ix = col("x"), iy = col("y");
+    std::array<double, 2> c{0, 0};
+    for (long k = 0; k < n && std::getline(in, line); ++k) {
+      std::istringstream row(line);
+      std::vector<double> v;
+      for (double x; row >> x;) v.push_back(x);
+      c[0] += v.at(ix) / n;
+      c[1] += v.at(iy) / n;
+    }
+    out.push_back(c);
+  }
+  return out;
 }
 
 // Mass of the elements of a LIGGGHTS granular data file (id type diameter density x y z).
@@ -200,14 +238,110 @@ TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAK
   EXPECT_NE(table.find(",work_done\n"), std::string::npos) << table;
   EXPECT_NE(table.find(",t_end\n"), std::string::npos) << table;
 
-  // The report's headline has the in-mill row beside the single impact's.
+  // The animation: only the first run of the plan writes frames, 60 over
+  // its duration (fewer when it stops early), one every 8 ms / 60 rounded up
+  // to whole steps; the GIF holds them all, and the lump moved.
+  const std::string tasks = slurp(dir / "tasks.log");
+  const std::string first = tasks.find("rpm2000_mill_p1") < tasks.find("rpm2000_mill_p2")
+                                ? "rpm2000_mill_p1"
+                                : "rpm2000_mill_p2";
+  const std::string other = first == "rpm2000_mill_p1" ? "rpm2000_mill_p2" : "rpm2000_mill_p1";
+  EXPECT_NE(tasks.find("animated (60 frames)"), std::string::npos) << tasks;
+  EXPECT_FALSE(fs::exists(stage / "jobs" / other / "run/frames.dump")) << other;
+  const auto anim = nlohmann::json::parse(slurp(stage / "animation/animation.json"));
+  const auto run = nlohmann::json::parse(slurp(stage / "jobs" / first / "in_mill.json"));
+  EXPECT_EQ(anim.at("job").get<std::string>(), first);
+  const double every_ms = anim.at("frame_interval_ms").get<double>();
+  EXPECT_GE(every_ms, 8.0 / 60 - 1e-9) << anim.dump(2);
+  EXPECT_LT(every_ms, 8.0 / 60 * 1.05) << anim.dump(2);
+  const double stop_ms = 1e3 * run.at("stop").at("time_s").get<double>();
+  const int frames = anim.at("frames").get<int>();
+  EXPECT_EQ(frames, static_cast<int>(std::floor(stop_ms / every_ms + 1e-6)) + 1)
+      << "stopped at " << stop_ms << " ms; " << anim.dump(2);
+  if (run.at("stop").at("reason") == "t_end") {
+    EXPECT_GE(frames, 60) << anim.dump(2);
+    EXPECT_LE(frames, 61) << anim.dump(2);
+  }
+  const auto centroids = dump_centroids(stage / "jobs" / first / "run/frames.dump");
+  ASSERT_EQ(static_cast<int>(centroids.size()), frames);
+  EXPECT_NEAR(anim.at("centroid_first_m")[0].get<double>(), centroids.front()[0], 1e-6);
+  EXPECT_NEAR(anim.at("centroid_last_m")[1].get<double>(), centroids.back()[1], 1e-6);
+  const double moved = std::hypot(centroids.back()[0] - centroids.front()[0],
+                                  centroids.back()[1] - centroids.front()[1]);
+  EXPECT_GT(moved, 0.02) << "the lump's centroid moved " << moved << " m (one lump diameter: 0.02)";
+  EXPECT_GT(anim.at("first_last_pixel_difference").get<double>(), 0.5) << anim.dump(2);
+  const std::string n_frames =
+      "/usr/bin/python3 -c 'import sys; from PIL import Image; "
+      "print(Image.open(sys.argv[1]).n_frames)' " +
+      (stage / "animation/animation.gif").string() + " > " + (dir / "gif_frames.txt").string();
+  ASSERT_EQ(std::system(n_frames.c_str()), 0);
+  EXPECT_EQ(std::stoi(slurp(dir / "gif_frames.txt")), frames);
+  EXPECT_LT(fs::file_size(stage / "animation/animation.gif"), 5u << 20);
+  for (const char* s : {"animation_first.png", "animation_middle.png", "animation_last.png"})
+    EXPECT_EQ(slurp(stage / "animation" / s), slurp(stage / "jobs" / first / "animation" / s)) << s;
+
+  // The report's headline has the in-mill row beside the single impact's,
+  // and the breakage section shows the animation with its caption.
   ASSERT_EQ(orchestrate("--case " + yaml + " --stage report --output " + dir.string(),
                         dir / "report.log"),
             0)
       << slurp(dir / "report.log");
-  EXPECT_NE(slurp(dir / "report/index.html")
-                .find("in the mill (2 lumps, strike and housing impacts), 2000 rpm"),
+  const std::string page = slurp(dir / "report/index.html");
+  EXPECT_NE(page.find("in the mill (2 lumps, strike and housing impacts), 2000 rpm"),
             std::string::npos);
+  EXPECT_NE(page.find("<h3>One lump in the mill</h3>"), std::string::npos);
+  EXPECT_NE(page.find("src=\"data:image/gif;base64,R0lGOD"), std::string::npos);  // "GIF8"
+  const std::string caption =
+      fmt::format("Lump {} at 2000 rpm ({}): t = 0 is 2 ms before its first flywheel strike",
+                  run.at("start").at("particle_id").get<long long>(), first);
+  EXPECT_NE(page.find(caption), std::string::npos) << caption;
+  EXPECT_NE(page.find(fmt::format("{} frames from t = 0.00 to {:.2f} ms", frames,
+                                  anim.at("time_last_ms").get<double>())),
+            std::string::npos);
+  for (const char* s : {"first frame, t = 0.00 ms", "middle frame, t = ", "last frame, t = "})
+    EXPECT_NE(page.find(s), std::string::npos) << s;
+  const auto summary = nlohmann::json::parse(slurp(dir / "report/summary.json"));
+  EXPECT_EQ(summary.at("in_mill_animation").at("frames").get<int>(), frames);
+}
+
+// breakage.in_mill.animate: false: no run writes frames, and every in-mill
+// job keeps the id it has with the animation on, but the animated one.
+TEST(InMill, AnimationOffWritesNoFramesAndKeepsTheOtherJobIds) {
+  const fs::path dir = scratch("in_mill_no_animation");
+  write_transport_impacts(dir);
+  std::string yaml = slurp(kData + "/tiny_in_mill.yaml");
+  const std::string from = "gas: false}";
+  ASSERT_NE(yaml.find(from), std::string::npos);
+  spit(dir / "on.yaml", yaml);
+  yaml.replace(yaml.find(from), from.size(), "gas: false, animate: false}");
+  spit(dir / "off.yaml", yaml);
+  std::map<std::string, std::string> ids[2];
+  for (int k = 0; k < 2; ++k) {
+    const fs::path log = dir / (k ? "off.log" : "on.log");
+    ASSERT_EQ(orchestrate("--case " + (dir / (k ? "off.yaml" : "on.yaml")).string() +
+                              " --stage breakage --dry-run --output " + dir.string(),
+                          log),
+              0)
+        << slurp(log);
+    std::istringstream in(slurp(log));
+    for (std::string line; std::getline(in, line);) {
+      const auto at = line.rfind(", id ");
+      if (at == std::string::npos) continue;
+      std::istringstream w(line.substr(line.find(']') + 1));
+      std::string index, label;
+      w >> index >> label;
+      ids[k][label] = line.substr(at + 5, line.find(')', at) - at - 5);
+    }
+  }
+  ASSERT_TRUE(ids[0].count("rpm2000_mill_p1") && ids[0].count("rpm2000_mill_p2"))
+      << slurp(dir / "on.log");
+  int differ = 0;
+  for (const auto& [label, id] : ids[0]) {
+    ASSERT_TRUE(ids[1].count(label)) << label;
+    differ += id != ids[1][label];
+  }
+  EXPECT_EQ(differ, 1) << slurp(dir / "on.log") << slurp(dir / "off.log");
+  EXPECT_EQ(slurp(dir / "off.log").find("animated"), std::string::npos) << slurp(dir / "off.log");
 }
 
 // With gas: still air of 1.2 kg/m3 over the tiny housing (a field where the

@@ -14,6 +14,7 @@
 #include "postprocess/in_mill.h"
 #include "postprocess/lammps_dump.h"
 #include "progress.h"
+#include "stages/breakage/in_mill_animation.h"
 #include "stages/breakage/lump_run.h"
 #include "stages/breakage/summaries.h"
 #include "stages/stage_util.h"
@@ -131,13 +132,17 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan) {
     in["strike_speed_m_s"] = s.strike_speed_m_s;
     in["strike_normal_speed_m_s"] = s.strike_normal_speed_m_s;
     in["strike_angle_deg"] = s.strike_angle_deg;
+    // The run the report animates: only its inputs (and id) change.
+    if (const nlohmann::json a = animation_inputs(d, plan); !a.is_null()) in["animation"] = a;
     plan.jobs.push_back(
         {fmt::format("{}_mill_p{}", rpm_label(rpm), s.particle_id), in,
          fmt::format(
              "{} in-mill: lump {} of stage 1 from {:g} ms before its flywheel strike at {:.1f} "
-             "m/s ({:.0f} deg), {:g} ms in the mill",
+             "m/s ({:.0f} deg), {:g} ms in the mill{}",
              rpm_label(rpm), s.particle_id, 1e3 * d.real("breakage.in_mill.lead_time"),
-             s.strike_speed_m_s, s.strike_angle_deg, 1e3 * d.real("breakage.in_mill.duration"))});
+             s.strike_speed_m_s, s.strike_angle_deg, 1e3 * d.real("breakage.in_mill.duration"),
+             in.contains("animation") ? fmt::format(", animated ({} frames)", kAnimationFrames)
+                                      : std::string())});
   }
 }
 
@@ -245,7 +250,8 @@ std::vector<std::pair<std::string, std::string>> in_mill_vars(
       {"dt_speed", num(step.dt_speed)},
       {"skin", num(kSkinRadii * lr.lump.mean_radius)},
       {"binsize", num(first_bin(d, g, lr))},
-      {"dump_interval", num(d.real("breakage.dump_interval"))}};
+      {"dump_interval", num(d.real("breakage.dump_interval"))},
+      {"frame_interval", num(frame_interval(in))}};
   for (const auto& kv : lump_deck_vars(ctx, lr)) v.push_back(kv);
   return v;
 }
@@ -407,6 +413,8 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
     throw std::runtime_error(fmt::format("{}: {}", label, e.what()));
   }
 
+  if (is_animated(job)) render_animation(ctx, job, lr.work, lr.work / "stl", g, out_dir);
+
   nlohmann::json j = lump_result_json(lr, a, res.seconds);
   add_in_mill_keys(j, d, in, record);
   jobs::atomic_write(out_dir / "in_mill.json", j.dump(2) + "\n");
@@ -414,13 +422,16 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
   return in_mill_line(in, a, record, res.seconds);
 }
 
-std::string damaged_in_mill_outputs(const fs::path& dir) {
+std::string damaged_in_mill_outputs(const JobSpec& job, const fs::path& dir) {
   if (auto r = damaged_lump_outputs(dir); !r.empty()) return r;
+  if (is_animated(job))
+    if (auto r = damaged_animation(dir); !r.empty()) return r;
   return jobs::check_json(dir / "in_mill.json");
 }
 
 std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
                                                        const std::vector<JobSpec>& jobs) {
+  publish_animation(ctx, jobs);
   const jobs::JobStore store(ctx.stage_dir);
   const auto edges = ctx.cfg.doc.reals("breakage.size_fraction_edges");
   const double d_mm = 1000 * ctx.cfg.doc.real("lump.diameter");

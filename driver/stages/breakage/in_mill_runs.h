@@ -27,11 +27,12 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan);
 std::string run_in_mill(StageContext& ctx, const JobSpec& job,
                         const std::filesystem::path& out_dir);
 
-// The outputs run_in_mill writes exist and parse: "" or the reason.
-std::string damaged_in_mill_outputs(const std::filesystem::path& dir);
+// The outputs run_in_mill writes for `job` exist and parse: "" or the reason.
+std::string damaged_in_mill_outputs(const JobSpec& job, const std::filesystem::path& dir);
 
-// breakage/in_mill.csv (one row per run) and, per rotor speed, the in-mill
-// product object of product.json (averaged over the runs).
+// breakage/in_mill.csv (one row per run), breakage/animation/ (the animated
+// run's, in_mill_animation.h) and, per rotor speed, the in-mill product
+// object of product.json (averaged over the runs).
 std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
                                                        const std::vector<JobSpec>& jobs);
 
