@@ -2,9 +2,9 @@
 //
 // PowerIntegral integrates a power P(t) [W] sampled at the full steps of
 // velocity Verlet with the trapezoidal rule, one step's trapezoid at the end
-// of each step (with that step's length, which may change between runs). With every force family's power summed
-// this way, the kinetic energy follows exactly, up to the integrator's shadow
-// term (docs/styles/fix_energy_ledger.md, "Exact bookkeeping").
+// of each step (with that step's length, which may change between runs). With every force family's
+// power summed this way, the kinetic energy follows exactly, up to the integrator's shadow term
+// (docs/styles/fix_energy_ledger.md, "Exact bookkeeping").
 #ifndef MILL_ENERGY_TERMS_H
 #define MILL_ENERGY_TERMS_H
 

@@ -591,8 +591,8 @@ std::vector<double> FixEnergyLedger::local_step_sums() const {
   const int nd = std::min(atom->nlocal, static_cast<int>(fdamp_.size() / 3));
   for (int i = 0; i < np; ++i)
     if (mask[i] & moved_)
-      e[WP] += mill::end_term(&fpair_[6 * i], &fpair_[6 * i + 3], f[i], torque[i], rmass[i],
-                              radius[i]);
+      e[WP] +=
+          mill::end_term(&fpair_[6 * i], &fpair_[6 * i + 3], f[i], torque[i], rmass[i], radius[i]);
   for (int i = 0; i < nd; ++i)
     if (mask[i] & moved_)
       e[WDP] += mill::end_term(&fdamp_[3 * i], no_torque, f[i], torque[i], rmass[i], radius[i]);

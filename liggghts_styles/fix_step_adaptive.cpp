@@ -66,11 +66,11 @@ FixStepAdaptive::FixStepAdaptive(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
   nevery = every_ > 0 ? every_ : 1;
   if (comm->me == 0 && !file_.empty()) {
     out_ = fopen(file_.c_str(), "w");
-    if (!out_)
-      error->one(FLERR, ("fix step/adaptive: cannot open file '" + file_ + "'").c_str());
-    fprintf(out_,
-            "# fix step/adaptive: the step at each re-evaluation (docs/styles/fix_step_adaptive.md)\n"
-            "step,time_s,dt_s,dt_bonds_s,intact_bonds\n");
+    if (!out_) error->one(FLERR, ("fix step/adaptive: cannot open file '" + file_ + "'").c_str());
+    fprintf(
+        out_,
+        "# fix step/adaptive: the step at each re-evaluation (docs/styles/fix_step_adaptive.md)\n"
+        "step,time_s,dt_s,dt_bonds_s,intact_bonds\n");
     fflush(out_);
   }
 }

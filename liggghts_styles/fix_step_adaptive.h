@@ -44,12 +44,12 @@ class FixStepAdaptive : public Fix {
   std::string bonds_id_;
   FixBondBreakable *bonds_ = nullptr;
   mill::step_limit::StepRule rule_;
-  int every_ = 0;            // also every this many steps (0: at the end of runs only)
-  std::string file_;         // log of the evaluations (rank 0), "" = none
+  int every_ = 0;     // also every this many steps (0: at the end of runs only)
+  std::string file_;  // log of the evaluations (rank 0), "" = none
   FILE *out_ = nullptr;
-  bigint last_step_ = -1;    // step of the last evaluation
-  double dt_bonds_ = 0.0;    // the bonds' critical step at the last evaluation [s]
-  double changes_ = 0.0;     // how often the step changed
+  bigint last_step_ = -1;  // step of the last evaluation
+  double dt_bonds_ = 0.0;  // the bonds' critical step at the last evaluation [s]
+  double changes_ = 0.0;   // how often the step changed
 };
 
 }  // namespace LAMMPS_NS

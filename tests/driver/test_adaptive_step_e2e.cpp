@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
-
 #include <sstream>
 
 #include "e2e_util.h"
@@ -43,8 +42,8 @@ fs::path run_case(bool adaptive) {
   std::string text = slurp(kData + "/tiny_adaptive.yaml");
   if (!adaptive) text.replace(text.find("adaptive_step: true"), 19, "adaptive_step: false");
   spit(dir / "case.yaml", text);
-  const int st = orchestrate("--case " + (dir / "case.yaml").string() + " --stage breakage --output " +
-                                 (dir / "run").string(),
+  const int st = orchestrate("--case " + (dir / "case.yaml").string() +
+                                 " --stage breakage --output " + (dir / "run").string(),
                              dir / "run.log");
   EXPECT_EQ(st, 0) << slurp(dir / "run.log");
   return dir / "run/breakage/jobs/v150_a90_r0";
@@ -74,15 +73,20 @@ TEST(AdaptiveStep, LedgerClosesAndStepGrowsAfterShattering) {
     if (r.dt > dt0 * 1.01 && intact_at_growth < 0) intact_at_growth = r.intact;
     dt_max = std::max(dt_max, r.dt);
     EXPECT_TRUE(r.dt_bonds == 0 || r.dt <= 0.5 * r.dt_bonds * (1 + 1e-9))
-        << "step " << r.dt << " s above half the bonds' critical step " << r.dt_bonds << " s at t = " << r.time;
+        << "step " << r.dt << " s above half the bonds' critical step " << r.dt_bonds
+        << " s at t = " << r.time;
   }
   std::printf(
-      "adaptive step: %zu re-evaluations, step %.3g s (first chunk, %g bonds made) -> %.3g s (at most), "
-      "first growth with %g bonds left; residual/input %.2e adaptive, %.2e fixed (bound 1e-2); broken bonds %.1f%% "
+      "adaptive step: %zu re-evaluations, step %.3g s (first chunk, %g bonds made) -> %.3g s (at "
+      "most), "
+      "first growth with %g bonds left; residual/input %.2e adaptive, %.2e fixed (bound 1e-2); "
+      "broken bonds %.1f%% "
       "adaptive, %.1f%% fixed; largest piece %.1f%% / %.1f%%\n",
       rows.size(), dt0, bonds0, dt_max, intact_at_growth, res_a, res_f,
-      100 * ra.at("broken_bond_fraction").get<double>(), 100 * rf.at("broken_bond_fraction").get<double>(),
-      100 * ra.at("largest_mass_fraction").get<double>(), 100 * rf.at("largest_mass_fraction").get<double>());
+      100 * ra.at("broken_bond_fraction").get<double>(),
+      100 * rf.at("broken_bond_fraction").get<double>(),
+      100 * ra.at("largest_mass_fraction").get<double>(),
+      100 * rf.at("largest_mass_fraction").get<double>());
   EXPECT_LT(std::abs(res_a), 0.01);  // the ledger's bound (residual_bound of the deck)
   EXPECT_GT(dt_max, 1.5 * dt0) << "the step did not grow";
   EXPECT_GE(intact_at_growth, 0);
@@ -90,7 +94,8 @@ TEST(AdaptiveStep, LedgerClosesAndStepGrowsAfterShattering) {
   EXPECT_FALSE(fs::exists(fixed / "run/steps.csv"));
   // Both shattered the lump: at 150 m/s nearly every bond breaks.
   EXPECT_GT(ra.at("broken_bond_fraction").get<double>(), 0.9);
-  EXPECT_NEAR(ra.at("broken_bond_fraction").get<double>(), rf.at("broken_bond_fraction").get<double>(), 0.05);
+  EXPECT_NEAR(ra.at("broken_bond_fraction").get<double>(),
+              rf.at("broken_bond_fraction").get<double>(), 0.05);
 }
 
 }  // namespace

@@ -33,7 +33,8 @@ double largest_eigenvalue(std::vector<double> a, int n) {
         const double apq = a[p * n + q];
         if (std::fabs(apq) < 1e-300) continue;
         const double theta = 0.5 * (a[q * n + q] - a[p * n + p]) / apq;
-        const double t = (theta >= 0 ? 1.0 : -1.0) / (std::fabs(theta) + std::sqrt(theta * theta + 1.0));
+        const double t =
+            (theta >= 0 ? 1.0 : -1.0) / (std::fabs(theta) + std::sqrt(theta * theta + 1.0));
         const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
         for (int k = 0; k < n; ++k) {  // columns p, q
           const double akp = a[k * n + p], akq = a[k * n + q];
@@ -74,7 +75,8 @@ void add_bond_stiffness(const BondSprings &s, const std::vector<Sphere> &sp, con
   l0 = std::sqrt(l0);
   double e[3][3];  // bond frame: e[0] the axis, e[1], e[2] perpendicular
   for (int q = 0; q < 3; ++q) e[0][q] = d[q] / l0;
-  const double helper[3] = {std::fabs(e[0][0]) < 0.9 ? 1.0 : 0.0, std::fabs(e[0][0]) < 0.9 ? 0.0 : 1.0, 0.0};
+  const double helper[3] = {std::fabs(e[0][0]) < 0.9 ? 1.0 : 0.0,
+                            std::fabs(e[0][0]) < 0.9 ? 0.0 : 1.0, 0.0};
   double dotp = 0.0;
   for (int q = 0; q < 3; ++q) dotp += helper[q] * e[0][q];
   double nrm = 0.0;
@@ -92,7 +94,7 @@ void add_bond_stiffness(const BondSprings &s, const std::vector<Sphere> &sp, con
   const double arm_a = l0 * a.r / (a.r + c.r), arm_c = l0 - arm_a;
   // Each spring: stiffness times g g^T, g the spring's strain as a linear form of
   // the 12 coordinates (u_a, th_a, u_c, th_c) in the global frame.
-  auto spring = [&](double stiff, const double (&g)[12]) {
+  auto spring = [&](double stiff, const double(&g)[12]) {
     const int base[4] = {6 * b.i, 6 * b.i + 3, 6 * b.j, 6 * b.j + 3};
     for (int p = 0; p < 12; ++p)
       for (int q = 0; q < 12; ++q)
@@ -123,7 +125,8 @@ void add_bond_stiffness(const BondSprings &s, const std::vector<Sphere> &sp, con
 }
 
 // Largest omega^2 of the bonds `bonds` over the spheres (M^-1/2 K M^-1/2).
-double network_omega2(const BondSprings &s, const std::vector<Sphere> &sp, const std::vector<Bond> &bonds) {
+double network_omega2(const BondSprings &s, const std::vector<Sphere> &sp,
+                      const std::vector<Bond> &bonds) {
   const int n = 6 * static_cast<int>(sp.size());
   std::vector<double> k(static_cast<size_t>(n) * n, 0.0);
   for (const Bond &b : bonds) add_bond_stiffness(s, sp, b, k, n);
@@ -140,12 +143,14 @@ double network_omega2(const BondSprings &s, const std::vector<Sphere> &sp, const
 
 // The bonds' critical step as fix bond/breakable computes it: per atom the
 // sum of its bonds' bond_omega2.
-double fix_critical_step(const BondSprings &s, const std::vector<Sphere> &sp, const std::vector<Bond> &bonds) {
+double fix_critical_step(const BondSprings &s, const std::vector<Sphere> &sp,
+                         const std::vector<Bond> &bonds) {
   std::vector<double> sum(sp.size(), 0.0);
   for (const Bond &b : bonds) {
     const Sphere &a = sp[b.i], &c = sp[b.j];
-    const double l0 = std::sqrt((c.x[0] - a.x[0]) * (c.x[0] - a.x[0]) + (c.x[1] - a.x[1]) * (c.x[1] - a.x[1]) +
-                                (c.x[2] - a.x[2]) * (c.x[2] - a.x[2]));
+    const double l0 =
+        std::sqrt((c.x[0] - a.x[0]) * (c.x[0] - a.x[0]) + (c.x[1] - a.x[1]) * (c.x[1] - a.x[1]) +
+                  (c.x[2] - a.x[2]) * (c.x[2] - a.x[2]));
     const double w2 = mill::step_limit::bond_omega2(s, BondedPair{a.r, c.r, a.m, c.m, l0});
     sum[b.i] += w2;
     sum[b.j] += w2;
@@ -195,7 +200,8 @@ TEST(StepLimit, PairOmegaMatchesEigenvalue) {
     const Sphere &a = l.spheres[b.i], &c = l.spheres[b.j];
     double l0 = 0.0;
     for (int q = 0; q < 3; ++q) l0 += (c.x[q] - a.x[q]) * (c.x[q] - a.x[q]);
-    const double closed = mill::step_limit::bond_omega2(l.springs, {a.r, c.r, a.m, c.m, std::sqrt(l0)});
+    const double closed =
+        mill::step_limit::bond_omega2(l.springs, {a.r, c.r, a.m, c.m, std::sqrt(l0)});
     EXPECT_NEAR(closed / direct, 1.0, 1e-9) << "bond " << b.i << "-" << b.j;
   }
 }
@@ -231,11 +237,15 @@ TEST(StepLimit, StepNeverExceedsAnyRemainingBond) {
           << " x the critical step of bond " << b.i << "-" << b.j;
     }
     const double net = l.bonds.empty() ? 0.0 : network_omega2(l.springs, l.spheres, l.bonds);
-    EXPECT_LE(next * std::sqrt(net) / 2.0, 1.0) << "round " << round << ": the network's critical step";
-    EXPECT_LE(next * std::sqrt(net) / 2.0, rule.safety * (1 + 1e-9)) << "round " << round << ": the network";
-    std::printf("round %d: %zu bonds left, step %.4g s (%.3g x the first), dt omega / 2 at most %.3f (bonds), "
-                "%.3f (network)\n",
-                round, l.bonds.size(), next, next / dt0, worst, next * std::sqrt(net) / 2.0);
+    EXPECT_LE(next * std::sqrt(net) / 2.0, 1.0)
+        << "round " << round << ": the network's critical step";
+    EXPECT_LE(next * std::sqrt(net) / 2.0, rule.safety * (1 + 1e-9))
+        << "round " << round << ": the network";
+    std::printf(
+        "round %d: %zu bonds left, step %.4g s (%.3g x the first), dt omega / 2 at most %.3f "
+        "(bonds), "
+        "%.3f (network)\n",
+        round, l.bonds.size(), next, next / dt0, worst, next * std::sqrt(net) / 2.0);
     dt = next;
     if (l.bonds.empty()) break;
     // A round of breaks: a third of the bonds left (all when 3 or fewer).
@@ -251,10 +261,10 @@ TEST(StepLimit, StepNeverExceedsAnyRemainingBond) {
 // Growth is limited per re-evaluation, and a smaller bound cuts the step at once.
 TEST(StepLimit, GrowthLimitedAndShrinksAtOnce) {
   const StepRule rule{0.5, 1e-6, 2.0};
-  EXPECT_DOUBLE_EQ(mill::step_limit::next_step(1e-8, 0.0, rule), 2e-8);      // no bonds: growth 2
-  EXPECT_DOUBLE_EQ(mill::step_limit::next_step(1e-7, 1e-7, rule), 5e-8);     // safety x bonds' step
-  EXPECT_DOUBLE_EQ(mill::step_limit::next_step(8e-7, 0.0, rule), 1e-6);      // the cap
-  EXPECT_DOUBLE_EQ(mill::step_limit::next_step(2e-6, 0.0, rule), 1e-6);      // above the cap: cut
-  EXPECT_DOUBLE_EQ(mill::step_limit::critical_step(0.0), 0.0);               // no bond: no bound
-  EXPECT_DOUBLE_EQ(mill::step_limit::critical_step(4.0), 1.0);               // omega dt = 2
+  EXPECT_DOUBLE_EQ(mill::step_limit::next_step(1e-8, 0.0, rule), 2e-8);   // no bonds: growth 2
+  EXPECT_DOUBLE_EQ(mill::step_limit::next_step(1e-7, 1e-7, rule), 5e-8);  // safety x bonds' step
+  EXPECT_DOUBLE_EQ(mill::step_limit::next_step(8e-7, 0.0, rule), 1e-6);   // the cap
+  EXPECT_DOUBLE_EQ(mill::step_limit::next_step(2e-6, 0.0, rule), 1e-6);   // above the cap: cut
+  EXPECT_DOUBLE_EQ(mill::step_limit::critical_step(0.0), 0.0);            // no bond: no bound
+  EXPECT_DOUBLE_EQ(mill::step_limit::critical_step(4.0), 1.0);            // omega dt = 2
 }
