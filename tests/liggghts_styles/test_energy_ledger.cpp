@@ -266,7 +266,9 @@ void check_high_speed_impact(const std::string &bonds, const std::string &tag, d
     for (const auto &r : steps) {
       ASSERT_EQ(r.size(), 5u);
       dt_max = std::max(dt_max, r[2]);
-      if (r[3] > 0) EXPECT_LE(r[2], 0.1 * r[3] * (1 + 1e-9)) << "at step " << r[0];
+      if (r[3] > 0) {
+        EXPECT_LE(r[2], 0.1 * r[3] * (1 + 1e-9)) << "at step " << r[0];
+      }
     }
     std::printf("adaptive: %zu re-evaluations, step %.4g -> %.4g s at most\n", steps.size(), dt0,
                 dt_max);
