@@ -153,7 +153,9 @@ void FixEnergyLedger::init() {
   find_restitution();
   if (interval_ > 0.0) every_ = std::max(1, static_cast<int>(std::lround(interval_ / update->dt)));
   global_freq = every_;
-  if (books_dt_ == 0.0) books_dt_ = update->dt;
+  // A `timestep` command between runs changed the step: bank as reset_dt does
+  // (the forces are still those of the last step).
+  bank_step_change();
   if (!force->pair)
     error->all(FLERR, "fix energy/ledger: needs a pair style (the element contacts)");
   if (comm->me == 0 && !out_ && !file_.empty()) {
@@ -563,12 +565,16 @@ void FixEnergyLedger::sample(bool write) {
 // with the new step is banked, so the row of step K reads the same with
 // either. The interval between samples is kept in time.
 void FixEnergyLedger::reset_dt() {
-  const double a = books_dt_, b = update->dt;
-  books_dt_ = b;
   if (interval_ > 0.0) {
-    every_ = std::max(1, static_cast<int>(std::lround(interval_ / b)));
+    every_ = std::max(1, static_cast<int>(std::lround(interval_ / update->dt)));
     global_freq = every_;
   }
+  bank_step_change();
+}
+
+void FixEnergyLedger::bank_step_change() {
+  const double a = books_dt_, b = update->dt;
+  books_dt_ = b;
   if (!started_ || a == b || a == 0.0) return;
   const std::vector<double> sums = local_step_sums();
   if (dt_offset_.size() < sums.size()) dt_offset_.resize(sums.size(), 0.0);

@@ -118,7 +118,8 @@ class FixEnergyLedger : public Fix {
   // that the books stay continuous across the change (fix_energy_ledger.md,
   // "A changing step").
   void reset_dt() override;
-  double books_dt_ = 0.0;          // the step of the shadow and end terms [s]
+  void bank_step_change();  // the banking of reset_dt, also at init (a `timestep` between runs)
+  double books_dt_ = 0.0;   // the step of the shadow and end terms [s]
   std::vector<double> dt_offset_;  // this rank's banked differences, per Sum [J]
   // This rank's sums of the dt-dependent terms in Sum order: S the shadow
   // term's sum |F|^2/m + |T|^2/I (times -dt^2/8), WP, WDP, WB, WW and the
