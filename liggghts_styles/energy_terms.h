@@ -1,11 +1,10 @@
 // Energy bookkeeping shared by the project's styles and fix energy/ledger.
 //
 // PowerIntegral integrates a power P(t) [W] sampled at the full steps of
-// velocity Verlet with the trapezoidal rule: the power at step n is added for
-// a whole step at the end of step n, and value() takes back the half step
-// that lies ahead of the last sample. With every force family's power summed
-// this way, the kinetic energy follows exactly, up to the integrator's shadow
-// term (docs/styles/fix_energy_ledger.md, "Exact bookkeeping").
+// velocity Verlet with the trapezoidal rule, one step's trapezoid at the end
+// of each step (with that step's length, which may change between runs). With every force family's
+// power summed this way, the kinetic energy follows exactly, up to the integrator's shadow term
+// (docs/styles/fix_energy_ledger.md, "Exact bookkeeping").
 #ifndef MILL_ENERGY_TERMS_H
 #define MILL_ENERGY_TERMS_H
 
@@ -35,27 +34,26 @@ inline double power6(const double *f6, int n, double *const *v, double *const *o
 }
 
 struct PowerIntegral {
-  double cum = 0.0;   // sum of P dt, with the first sample weighted 1/2 [J]
+  double cum = 0.0;   // the trapezoidal integral up to the last sample [J]
   double last = 0.0;  // the last power sampled [W]
-  double dt = 0.0;    // the step of the last sample [s]
 
-  // The first sample (the setup of the first run): half a step ahead.
-  void start(double p, double step) {
-    cum = 0.5 * p * step;
+  // The first sample (the setup of the first run).
+  void start(double p, double /*step*/) {
+    cum = 0.0;
     last = p;
-    dt = step;
   }
-  // The sample at the end of a step.
+  // The sample at the end of a step of length `step`: that step's trapezoid,
+  // (last + p) step / 2, exact also when the step changed between samples
+  // (fix step/adaptive).
   void add(double p, double step) {
-    cum += p * step;
+    cum += 0.5 * (last + p) * step;
     last = p;
-    dt = step;
   }
   // The trapezoidal integral up to the last sample [J].
-  double value() const { return cum - 0.5 * last * dt; }
+  double value() const { return cum; }
   // The integral up to a sample p not yet added (read before the owner's
   // end_of_step ran this step) [J].
-  double value_with(double p, double step) const { return cum + 0.5 * p * step; }
+  double value_with(double p, double step) const { return cum + 0.5 * (last + p) * step; }
 };
 
 }  // namespace mill

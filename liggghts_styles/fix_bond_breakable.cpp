@@ -20,6 +20,7 @@
 #include "error.h"
 #include "memory.h"
 #include "neighbor.h"
+#include "step_limit.h"
 #include "style_args.h"
 #include "update.h"
 
@@ -1267,51 +1268,35 @@ void FixBondBreakable::write_bond_dump() {
   }
 }
 
-// Critical time step of the bond springs. Per bond, the largest squared
-// eigenfrequency of the free bonded pair is exact and in closed form: the
-// 12 x 12 pair problem splits into the axial mode, kn A (1/ma + 1/mb); the
-// twist, ks J (1/Ia + 1/Ib); and, in each of the two transverse planes, a
-// shear-bending block of rank 2 (shear spring ks A on g = (-1, 1, -ra, -rb)
-// over (ua, ub, theta_a, theta_b), bending spring kn I on h = (0, 0, -1, 1))
-// whose non-zero eigenvalues are those of the 2 x 2 Gram matrix
-//   [ ks A g.M^-1.g            sqrt(ks A kn I) g.M^-1.h ]
-//   [ sqrt(ks A kn I) g.M^-1.h   kn I h.M^-1.h          ].
-// An atom's estimate sums its bonds' values (exact for a pair and for the
-// axial mode of a uniform chain); velocity Verlet is stable for omega dt < 2.
-// Printed; warns if the deck's dt exceeds it.
-void FixBondBreakable::estimate_time_step() {
+// Critical time step of the bond springs over the bonds left now: per bond
+// the exact largest squared eigenfrequency of the free bonded pair
+// (step_limit.h, bond_omega2); an atom's estimate sums its bonds' values
+// (exact for a pair and for the axial mode of a uniform chain); velocity
+// Verlet is stable for omega dt < 2. 0 when no bond is left. Collective
+// (one reduction); caches the value for f_ID[6].
+double FixBondBreakable::critical_step() {
   double *radius = atom->radius, *rmass = atom->rmass;
+  const mill::step_limit::BondSprings springs{modulus_, stiffness_ratio_, radius_multiplier_};
   double local = 0.0;  // largest per-atom sum of the bonds' omega^2
   for (int i = 0; i < atom->nlocal; ++i) {
     double sum = 0.0;
     for (int k = 0; k < nbond_[i]; ++k) {
       const int j = partner_index(i, static_cast<int>(bonds_[i][k * ncol_ + PARTNER]));
-      const double l0 = bonds_[i][k * ncol_ + L0];
-      const double rb = radius_multiplier_ * std::min(radius[i], radius[j]);
-      const double area = kPi * rb * rb, inertia = 0.25 * area * rb * rb;
-      const double kn = modulus_ / l0, ks = kn / stiffness_ratio_;
-      const double arm_i = l0 * radius[i] / (radius[i] + radius[j]), arm_j = l0 - arm_i;
-      const double inv_m = 1.0 / rmass[i] + 1.0 / rmass[j];
-      const double inv_ii = 1.0 / (0.4 * rmass[i] * radius[i] * radius[i]);
-      const double inv_ij = 1.0 / (0.4 * rmass[j] * radius[j] * radius[j]);
-      const double w2_axial = kn * area * inv_m;
-      const double w2_twist = ks * 2.0 * inertia * (inv_ii + inv_ij);
-      const double a = ks * area * (inv_m + arm_i * arm_i * inv_ii + arm_j * arm_j * inv_ij);
-      const double c = kn * inertia * (inv_ii + inv_ij);
-      const double gh = arm_i * inv_ii - arm_j * inv_ij;
-      const double w2_bend =
-          0.5 * (a + c) + std::sqrt(0.25 * (a - c) * (a - c) + ks * area * kn * inertia * gh * gh);
-      sum += std::max({w2_axial, w2_twist, w2_bend});
+      sum += mill::step_limit::bond_omega2(
+          springs, {radius[i], radius[j], rmass[i], rmass[j], bonds_[i][k * ncol_ + L0]});
     }
     local = std::max(local, sum);
   }
   double global = 0.0;
   MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_MAX, world);
-  if (global <= 0.0) {
-    dt_crit_ = 0.0;
-    return;
-  }
-  dt_crit_ = 2.0 / std::sqrt(global);
+  dt_crit_ = mill::step_limit::critical_step(global);
+  return dt_crit_;
+}
+
+// At the setup of a run: the critical step, printed; warns if the deck's dt
+// exceeds it.
+void FixBondBreakable::estimate_time_step() {
+  if (critical_step() <= 0.0) return;
   char line[256];
   snprintf(line, sizeof(line),
            "%scritical time step of bond springs %.4g s; time step %.4g s",

@@ -87,6 +87,10 @@ class FixBondBreakable : public Fix {
   double local_end_term(int groupbit) const;
   // This step's bond forces and torques on the owned atoms (6 per atom).
   const std::vector<double> &ledger_forces() const { return fbond_; }
+  // The bond springs' critical time step over the bonds left now [s], 0
+  // when none is left (step_limit.h); also what f_ID[6] reads from then on.
+  // Collective: every rank calls it at the same step.
+  double critical_step();
 
  private:
   // "fix <style>: ", the start of every message.

@@ -153,6 +153,9 @@ void FixEnergyLedger::init() {
   find_restitution();
   if (interval_ > 0.0) every_ = std::max(1, static_cast<int>(std::lround(interval_ / update->dt)));
   global_freq = every_;
+  // A `timestep` command between runs changed the step: bank as reset_dt does
+  // (the forces are still those of the last step).
+  bank_step_change();
   if (!force->pair)
     error->all(FLERR, "fix energy/ledger: needs a pair style (the element contacts)");
   if (comm->me == 0 && !out_ && !file_.empty()) {
@@ -447,7 +450,6 @@ void FixEnergyLedger::post_run() {
 // Sums the terms over ranks (one reduction), closes the balance, checks the
 // residual, writes a row (rank 0).
 void FixEnergyLedger::sample(bool write) {
-  enum { T = 0, R, S, CE, WP, WDP, WB, BE, BE0, BR, BD, BF, WW, WE, WE0, WD, WF, INJ, NSUM };
   const size_t nsum = NSUM + parts_.size();
   std::vector<double> loc(nsum, 0.0), glob(nsum, 0.0);
   local_kinetic(loc[T], loc[R], loc[S]);
@@ -490,6 +492,7 @@ void FixEnergyLedger::sample(bool write) {
     loc[WE0] = w.elastic0;
     loc[WF] = w.friction;
   }
+  for (size_t k = 0; k < dt_offset_.size() && k < nsum; ++k) loc[k] += dt_offset_[k];
   MPI_Allreduce(loc.data(), glob.data(), static_cast<int>(nsum), MPI_DOUBLE, MPI_SUM, world);
   const double lmax[2] = {vmax_sq_, wall_ ? wall_->local_energy().max_overlap : 0.0};
   double gmax[2] = {0.0, 0.0};
@@ -552,6 +555,57 @@ void FixEnergyLedger::sample(bool write) {
     }
     error->all(FLERR, m);
   }
+}
+
+// The step changed from books_dt_ to update->dt at the end of step K (the
+// forces are F_K). Each step's work is exact with that step's own length
+// (trapezoid less end term, energy_terms.h), but the shadow term
+// -dt^2/8 |F_K|^2/m and the end terms -dt^2/4 f_K.F_K/m that the books hold
+// at step K were taken with the old step: their difference to the same terms
+// with the new step is banked, so the row of step K reads the same with
+// either. The interval between samples is kept in time.
+void FixEnergyLedger::reset_dt() {
+  if (interval_ > 0.0) {
+    every_ = std::max(1, static_cast<int>(std::lround(interval_ / update->dt)));
+    global_freq = every_;
+  }
+  bank_step_change();
+}
+
+void FixEnergyLedger::bank_step_change() {
+  const double a = books_dt_, b = update->dt;
+  books_dt_ = b;
+  if (!started_ || a == b || a == 0.0) return;
+  const std::vector<double> sums = local_step_sums();
+  if (dt_offset_.size() < sums.size()) dt_offset_.resize(sums.size(), 0.0);
+  dt_offset_[S] += (b * b - a * a) / 8.0 * sums[S];
+  for (size_t k = 0; k < sums.size(); ++k)
+    if (k != S) dt_offset_[k] += (b * b - a * a) / 4.0 * sums[k];
+}
+
+std::vector<double> FixEnergyLedger::local_step_sums() const {
+  std::vector<double> e(NSUM + parts_.size(), 0.0);
+  double **f = atom->f, **torque = atom->torque;
+  const double *rmass = atom->rmass, *radius = atom->radius;
+  const int *mask = atom->mask;
+  for (int i = 0; i < atom->nlocal; ++i) {
+    if (!(mask[i] & moved_)) continue;
+    e[S] += mill::end_term(f[i], torque[i], f[i], torque[i], rmass[i], radius[i]);
+  }
+  const double no_torque[3] = {0.0, 0.0, 0.0};
+  const int np = std::min(atom->nlocal, static_cast<int>(fpair_.size() / 6));
+  const int nd = std::min(atom->nlocal, static_cast<int>(fdamp_.size() / 3));
+  for (int i = 0; i < np; ++i)
+    if (mask[i] & moved_)
+      e[WP] +=
+          mill::end_term(&fpair_[6 * i], &fpair_[6 * i + 3], f[i], torque[i], rmass[i], radius[i]);
+  for (int i = 0; i < nd; ++i)
+    if (mask[i] & moved_)
+      e[WDP] += mill::end_term(&fdamp_[3 * i], no_torque, f[i], torque[i], rmass[i], radius[i]);
+  for (size_t k = 0; k < parts_.size(); ++k) e[NSUM + k] = parts_[k]->local_end_term(moved_);
+  if (bonds_) e[WB] = bonds_->local_end_term(moved_);
+  if (wall_) e[WW] = wall_->local_end_term(moved_);
+  return e;
 }
 
 // Global outputs 1..NCOLUMN + parts: the last sample's columns (cached).

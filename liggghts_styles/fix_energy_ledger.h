@@ -110,6 +110,21 @@ class FixEnergyLedger : public Fix {
   void local_kinetic(double &trans, double &rot, double &shadow) const;
   void sample(bool write);
   void check_order() const;
+
+  // The terms sample() sums over ranks, in this order (then one per part).
+  enum Sum { T = 0, R, S, CE, WP, WDP, WB, BE, BE0, BR, BD, BF, WW, WE, WE0, WD, WF, INJ, NSUM };
+  // The step changed (fix step/adaptive, fix dt/reset): velocity Verlet's
+  // shadow and end terms, taken with the step of the sample, are banked so
+  // that the books stay continuous across the change (fix_energy_ledger.md,
+  // "A changing step").
+  void reset_dt() override;
+  void bank_step_change();  // the banking of reset_dt, also at init (a `timestep` between runs)
+  double books_dt_ = 0.0;   // the step of the shadow and end terms [s]
+  std::vector<double> dt_offset_;  // this rank's banked differences, per Sum [J]
+  // This rank's sums of the dt-dependent terms in Sum order: S the shadow
+  // term's sum |F|^2/m + |T|^2/I (times -dt^2/8), WP, WDP, WB, WW and the
+  // parts their end terms' sums (times -dt^2/4); 0 elsewhere.
+  std::vector<double> local_step_sums() const;
 };
 
 }  // namespace LAMMPS_NS

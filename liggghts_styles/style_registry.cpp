@@ -8,6 +8,7 @@
 #include "fix_energy_work.h"
 #include "fix_fluid_drag.h"
 #include "fix_impact_recorder.h"
+#include "fix_step_adaptive.h"
 #include "fix_wall_halfspace.h"
 #include "lammps.h"
 #include "modify.h"
@@ -61,6 +62,8 @@ std::vector<std::string> register_mill_styles(LAMMPS_NS::LAMMPS *lmp) {
   names.emplace_back(LAMMPS_NS::FixEnergyLedger::style_name());
   (*fix_map)[LAMMPS_NS::FixEnergyWork::style_name()] = &create_fix<LAMMPS_NS::FixEnergyWork>;
   names.emplace_back(LAMMPS_NS::FixEnergyWork::style_name());
+  (*fix_map)[LAMMPS_NS::FixStepAdaptive::style_name()] = &create_fix<LAMMPS_NS::FixStepAdaptive>;
+  names.emplace_back(LAMMPS_NS::FixStepAdaptive::style_name());
   return names;
 }
 

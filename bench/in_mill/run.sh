@@ -3,6 +3,7 @@
 #   bench/in_mill/run.sh [build-dir]
 #   DURATION=0.005 bench/in_mill/run.sh      a shorter run (s) for comparing settings
 #   LEAD_TIME=5e-5 DURATION=2.5e-4 ...        a run that starts closer to the strike (s)
+#   ADAPTIVE=1 DURATION=0.005 bench/in_mill/run.sh   with breakage.adaptive_step: true
 # The reference lump (3344 elements, the reference calibration's bonds) in the
 # reference mill at 2000 rpm for 20 ms on one core: stage 1's impact record is
 # one strike written here (the lump falling at 10 m/s onto plate 0's leading
@@ -46,9 +47,10 @@ open(f"{out}/calibrate/calibrated.yaml", "w").write(
     f"  input_hash: {h:016x}\n")
 PY
 case_file="$here/reference_in_mill.yaml"
-if [ -n "${DURATION:-}${LEAD_TIME:-}" ]; then
+if [ -n "${DURATION:-}${LEAD_TIME:-}${ADAPTIVE:-}" ]; then
   sed -e "s/duration: 0.02,/duration: ${DURATION:-0.02},/" \
       -e "s/lead_time: 2.0e-3,/lead_time: ${LEAD_TIME:-2.0e-3},/" "$case_file" > "$out.case.yaml"
+  [ "${ADAPTIVE:-0}" = 1 ] && sed -i -e "s/^  repeats: 1$/  repeats: 1\n  adaptive_step: true/" "$out.case.yaml"
   case_file="$out.case.yaml"
 fi
 /usr/bin/time -v "$build/bin/orchestrate" --case "$case_file" --stage breakage --task 1 \
@@ -60,6 +62,7 @@ steps=$(grep -E "^Loop time" "$log" | awk '{s += $9} END {print s}')
 loop=$(grep -E "^Loop time" "$log" | awk '{s += $4} END {print s}')
 cpu=$(grep -E "User time|System time" "$out/in_mill.time" | awk -F: '{s += $2} END {print s}')
 echo "steps $steps, loop time $loop s, element-steps per CPU second $(echo "3344 * $steps / $cpu" | bc -l)"
-grep -E "in_mill: dt|bins grow|Neighbor list builds|Dangerous" "$log" | head -20
+grep -E "in_mill: dt|in_mill: adaptive|bins grow|Neighbor list builds|Dangerous" "$log" | head -20
+[ -f "$job/run/steps.csv" ] && echo "steps.csv (step, time, dt, bonds' step, intact bonds):" && sed -n '3~4p' "$job/run/steps.csv"
 grep -E "Elapsed|Maximum resident|User time|System time" "$out/in_mill.time"
 echo "load average after the run: $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -619,6 +619,12 @@ void check_physics(const Document& d) {
     fail("breakage.timestep", fmt::format("expected 0 (automatic) or at most a tenth of breakage.duration_after_contact "
                                           "({:g} s), got {:g} s",
                                           after, bdt));
+  if (d.boolean("breakage.adaptive_step") && bdt > 0)
+    fail("breakage.adaptive_step",
+         fmt::format(
+             "the adaptive step re-evaluates the automatic step; expected breakage.timestep: 0 "
+             "(automatic) with it, or breakage.adaptive_step: false, got breakage.timestep {:g} s",
+             bdt));
 }
 
 // Plan limits (docs/errors.md, "Plan limits"): a stage of more jobs, a run

@@ -358,6 +358,13 @@ std::vector<KeyDef> breakage_keys() {
           at_least(key("breakage.timestep", T::Real, "s", "0",
                        "Time step; 0 = automatic from the stability limit"),
                    0),
+          key("breakage.adaptive_step", T::Bool, "", "false",
+              "With the automatic time step (breakage.timestep: 0), re-evaluate it at the end of "
+              "each 0.25 ms chunk of an impact or in-mill run from the bonds left: half the "
+              "critical step of the remaining bonds, at most the contacts' and the speed's bound "
+              "and twice the step before (fix step/adaptive, docs/styles/fix_step_adaptive.md). "
+              "The step grows once the lump has shattered; bench/README.md, \"Adaptive time "
+              "step\", measures what it gains; false = one step for the whole run"),
           at_least(key("breakage.dump_interval", T::Real, "s", "5e-4",
                        "VTK dump interval; 0 = no dumps"),
                    0),

@@ -114,6 +114,9 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan) {
   if (gas)
     for (const char* p : {"gas.", "flow.", "sample."}) keys.push_back(p);
   nlohmann::json base = case_keys(d, keys);
+  // The adaptive step is an input only when on: runs with the fixed step
+  // keep their job ids.
+  if (d.boolean("breakage.adaptive_step")) base["breakage.adaptive_step"] = true;
   base["ore"] = config::ore_keys(ctx.cfg.ore);
   base["bond"] = bond_json(bond_params_for(ctx.cfg, ctx.run_dir), BondNames::job);
   base["in_mill_deck_version"] = kInMillDeckVersion;
@@ -248,6 +251,7 @@ std::vector<std::pair<std::string, std::string>> in_mill_vars(
       {"stop_margin", num(d.real("lump.diameter"))},
       {"dt", num(d.real("breakage.timestep"))},
       {"dt_speed", num(step.dt_speed)},
+      {"adaptive_step", d.boolean("breakage.adaptive_step") ? "1" : "0"},
       {"skin", num(kSkinRadii * lr.lump.mean_radius)},
       {"binsize", num(first_bin(d, g, lr))},
       {"dump_interval", num(d.real("breakage.dump_interval"))},

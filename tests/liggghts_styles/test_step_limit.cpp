@@ -1,0 +1,270 @@
+// The time-step rule of fix step/adaptive (liggghts_styles/step_limit.h) on
+// hand-built pair lists, without LIGGGHTS: the step chosen after each round
+// of breaks never exceeds safety x the critical step of any remaining bond,
+// nor of the whole remaining network, each computed independently here as
+// the largest eigenvalue of M^-1/2 K M^-1/2 (Jacobi) of the 12 x 12 pair
+// problem and of the assembled network.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include "step_limit.h"
+
+namespace {
+
+using mill::step_limit::BondedPair;
+using mill::step_limit::BondSprings;
+using mill::step_limit::kPi;
+using mill::step_limit::StepRule;
+
+// Largest eigenvalue of the symmetric n x n matrix a (row-major), by cyclic Jacobi.
+double largest_eigenvalue(std::vector<double> a, int n) {
+  for (int sweep = 0; sweep < 100; ++sweep) {
+    double off = 0.0;
+    for (int p = 0; p < n; ++p)
+      for (int q = p + 1; q < n; ++q) off += a[p * n + q] * a[p * n + q];
+    if (off < 1e-30) break;
+    for (int p = 0; p < n; ++p)
+      for (int q = p + 1; q < n; ++q) {
+        const double apq = a[p * n + q];
+        if (std::fabs(apq) < 1e-300) continue;
+        const double theta = 0.5 * (a[q * n + q] - a[p * n + p]) / apq;
+        const double t =
+            (theta >= 0 ? 1.0 : -1.0) / (std::fabs(theta) + std::sqrt(theta * theta + 1.0));
+        const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
+        for (int k = 0; k < n; ++k) {  // columns p, q
+          const double akp = a[k * n + p], akq = a[k * n + q];
+          a[k * n + p] = c * akp - s * akq;
+          a[k * n + q] = s * akp + c * akq;
+        }
+        for (int k = 0; k < n; ++k) {  // rows p, q
+          const double apk = a[p * n + k], aqk = a[q * n + k];
+          a[p * n + k] = c * apk - s * aqk;
+          a[q * n + k] = s * apk + c * aqk;
+        }
+      }
+  }
+  double m = a[0];
+  for (int k = 1; k < n; ++k) m = std::max(m, a[k * n + k]);
+  return m;
+}
+
+struct Sphere {
+  double r, m;
+  double x[3];
+};
+struct Bond {
+  int i, j;
+};
+
+// Adds the parallel bond between spheres i and j (Potyondy & Cundall 2004,
+// eq. 5; axis from i to j, L0 their distance) to the stiffness matrix k of
+// the network, 6 coordinates per sphere (u, theta), row-major n x n.
+void add_bond_stiffness(const BondSprings &s, const std::vector<Sphere> &sp, const Bond &b,
+                        std::vector<double> &k, int n) {
+  const Sphere &a = sp[b.i], &c = sp[b.j];
+  double d[3], l0 = 0.0;
+  for (int q = 0; q < 3; ++q) {
+    d[q] = c.x[q] - a.x[q];
+    l0 += d[q] * d[q];
+  }
+  l0 = std::sqrt(l0);
+  double e[3][3];  // bond frame: e[0] the axis, e[1], e[2] perpendicular
+  for (int q = 0; q < 3; ++q) e[0][q] = d[q] / l0;
+  const double helper[3] = {std::fabs(e[0][0]) < 0.9 ? 1.0 : 0.0,
+                            std::fabs(e[0][0]) < 0.9 ? 0.0 : 1.0, 0.0};
+  double dotp = 0.0;
+  for (int q = 0; q < 3; ++q) dotp += helper[q] * e[0][q];
+  double nrm = 0.0;
+  for (int q = 0; q < 3; ++q) {
+    e[1][q] = helper[q] - dotp * e[0][q];
+    nrm += e[1][q] * e[1][q];
+  }
+  for (int q = 0; q < 3; ++q) e[1][q] /= std::sqrt(nrm);
+  e[2][0] = e[0][1] * e[1][2] - e[0][2] * e[1][1];
+  e[2][1] = e[0][2] * e[1][0] - e[0][0] * e[1][2];
+  e[2][2] = e[0][0] * e[1][1] - e[0][1] * e[1][0];
+  const double rb = s.radius_multiplier * std::min(a.r, c.r);
+  const double area = kPi * rb * rb, inertia = 0.25 * area * rb * rb, polar = 2.0 * inertia;
+  const double kn = s.modulus / l0, ks = kn / s.stiffness_ratio;
+  const double arm_a = l0 * a.r / (a.r + c.r), arm_c = l0 - arm_a;
+  // Each spring: stiffness times g g^T, g the spring's strain as a linear form of
+  // the 12 coordinates (u_a, th_a, u_c, th_c) in the global frame.
+  auto spring = [&](double stiff, const double(&g)[12]) {
+    const int base[4] = {6 * b.i, 6 * b.i + 3, 6 * b.j, 6 * b.j + 3};
+    for (int p = 0; p < 12; ++p)
+      for (int q = 0; q < 12; ++q)
+        k[(base[p / 3] + p % 3) * n + base[q / 3] + q % 3] += stiff * g[p] * g[q];
+  };
+  double g[12];
+  // Axial: (u_c - u_a) . e0.
+  for (int q = 0; q < 3; ++q) g[q] = -e[0][q], g[3 + q] = 0, g[6 + q] = e[0][q], g[9 + q] = 0;
+  spring(kn * area, g);
+  // Shear along t = e1, e2: relative displacement of the contact point,
+  // u_c + th_c x (-arm_c e0) - u_a - th_a x (arm_a e0), along t:
+  // (u_c - u_a).t - arm_c (e0 x t).th_c - arm_a (e0 x t).th_a.
+  for (int w = 1; w <= 2; ++w) {
+    double ext[3];  // e0 x t
+    ext[0] = e[0][1] * e[w][2] - e[0][2] * e[w][1];
+    ext[1] = e[0][2] * e[w][0] - e[0][0] * e[w][2];
+    ext[2] = e[0][0] * e[w][1] - e[0][1] * e[w][0];
+    for (int q = 0; q < 3; ++q)
+      g[q] = -e[w][q], g[3 + q] = -arm_a * ext[q], g[6 + q] = e[w][q], g[9 + q] = -arm_c * ext[q];
+    spring(ks * area, g);
+    // Bending about t: (th_c - th_a) . t.
+    for (int q = 0; q < 3; ++q) g[q] = 0, g[3 + q] = -e[w][q], g[6 + q] = 0, g[9 + q] = e[w][q];
+    spring(kn * inertia, g);
+  }
+  // Twist: (th_c - th_a) . e0.
+  for (int q = 0; q < 3; ++q) g[q] = 0, g[3 + q] = -e[0][q], g[6 + q] = 0, g[9 + q] = e[0][q];
+  spring(ks * polar, g);
+}
+
+// Largest omega^2 of the bonds `bonds` over the spheres (M^-1/2 K M^-1/2).
+double network_omega2(const BondSprings &s, const std::vector<Sphere> &sp,
+                      const std::vector<Bond> &bonds) {
+  const int n = 6 * static_cast<int>(sp.size());
+  std::vector<double> k(static_cast<size_t>(n) * n, 0.0);
+  for (const Bond &b : bonds) add_bond_stiffness(s, sp, b, k, n);
+  std::vector<double> inv_sqrt_m(n);
+  for (size_t a = 0; a < sp.size(); ++a)
+    for (int q = 0; q < 3; ++q) {
+      inv_sqrt_m[6 * a + q] = 1.0 / std::sqrt(sp[a].m);
+      inv_sqrt_m[6 * a + 3 + q] = 1.0 / std::sqrt(0.4 * sp[a].m * sp[a].r * sp[a].r);
+    }
+  for (int p = 0; p < n; ++p)
+    for (int q = 0; q < n; ++q) k[p * n + q] *= inv_sqrt_m[p] * inv_sqrt_m[q];
+  return largest_eigenvalue(k, n);
+}
+
+// The bonds' critical step as fix bond/breakable computes it: per atom the
+// sum of its bonds' bond_omega2.
+double fix_critical_step(const BondSprings &s, const std::vector<Sphere> &sp,
+                         const std::vector<Bond> &bonds) {
+  std::vector<double> sum(sp.size(), 0.0);
+  for (const Bond &b : bonds) {
+    const Sphere &a = sp[b.i], &c = sp[b.j];
+    const double l0 =
+        std::sqrt((c.x[0] - a.x[0]) * (c.x[0] - a.x[0]) + (c.x[1] - a.x[1]) * (c.x[1] - a.x[1]) +
+                  (c.x[2] - a.x[2]) * (c.x[2] - a.x[2]));
+    const double w2 = mill::step_limit::bond_omega2(s, BondedPair{a.r, c.r, a.m, c.m, l0});
+    sum[b.i] += w2;
+    sum[b.j] += w2;
+  }
+  return mill::step_limit::critical_step(*std::max_element(sum.begin(), sum.end()));
+}
+
+// A hand-built lump: 14 spheres of radii 0.6-1.6 mm (density 2580 kg/m3) on
+// a jittered cubic lattice, bonded to their neighbours within 1.15 x the sum
+// of the radii; sandstone-like springs (E_b 99.3 GPa, kn/ks 3.92).
+struct Lump {
+  BondSprings springs{99.3e9, 3.92, 1.0};
+  std::vector<Sphere> spheres;
+  std::vector<Bond> bonds;
+};
+
+Lump hand_built_lump() {
+  Lump l;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> radius(0.6e-3, 1.6e-3), jitter(-0.1e-3, 0.1e-3);
+  const double spacing = 3.0e-3;
+  for (int k = 0; k < 14; ++k) {
+    Sphere s;
+    s.r = radius(rng);
+    s.m = 2580.0 * 4.0 / 3.0 * kPi * s.r * s.r * s.r;
+    s.x[0] = (k % 3) * spacing + jitter(rng);
+    s.x[1] = ((k / 3) % 3) * spacing + jitter(rng);
+    s.x[2] = (k / 9) * spacing + jitter(rng);
+    l.spheres.push_back(s);
+  }
+  for (int i = 0; i < 14; ++i)
+    for (int j = i + 1; j < 14; ++j) {
+      double d2 = 0.0;
+      for (int q = 0; q < 3; ++q) d2 += std::pow(l.spheres[j].x[q] - l.spheres[i].x[q], 2);
+      if (std::sqrt(d2) < 1.15 * spacing) l.bonds.push_back({i, j});
+    }
+  return l;
+}
+
+}  // namespace
+
+// The closed form of one pair equals the pair's 12 x 12 eigenvalue.
+TEST(StepLimit, PairOmegaMatchesEigenvalue) {
+  const Lump l = hand_built_lump();
+  for (const Bond &b : l.bonds) {
+    const double direct = network_omega2(l.springs, l.spheres, {b});
+    const Sphere &a = l.spheres[b.i], &c = l.spheres[b.j];
+    double l0 = 0.0;
+    for (int q = 0; q < 3; ++q) l0 += (c.x[q] - a.x[q]) * (c.x[q] - a.x[q]);
+    const double closed =
+        mill::step_limit::bond_omega2(l.springs, {a.r, c.r, a.m, c.m, std::sqrt(l0)});
+    EXPECT_NEAR(closed / direct, 1.0, 1e-9) << "bond " << b.i << "-" << b.j;
+  }
+}
+
+// The lump shatters in rounds (a random third of the bonds left breaks each
+// round, then all); after each round the step is re-evaluated with the rule
+// of the decks (safety 0.5, growth 2, a cap of 4x the first step). The step
+// never exceeds safety x 2 / omega of any remaining bond, nor of the
+// remaining network; it grows once bonds are gone and reaches the cap when
+// none is left.
+TEST(StepLimit, StepNeverExceedsAnyRemainingBond) {
+  Lump l = hand_built_lump();
+  ASSERT_GE(l.bonds.size(), 20u);
+  const double dt0 = 0.5 * fix_critical_step(l.springs, l.spheres, l.bonds);
+  const StepRule rule{0.5, 4.0 * dt0, 2.0};
+  std::mt19937 rng(11);
+  double dt = dt0;
+  int round = 0;
+  while (true) {
+    const double dt_bonds = fix_critical_step(l.springs, l.spheres, l.bonds);
+    const double next = mill::step_limit::next_step(dt, dt_bonds, rule);
+    EXPECT_LE(next, rule.growth * dt * (1 + 1e-15)) << "round " << round;
+    EXPECT_LE(next, rule.dt_max) << "round " << round;
+    double worst = 0.0;  // largest dt x omega / 2 over the remaining bonds
+    for (const Bond &b : l.bonds) {
+      const double w2 = network_omega2(l.springs, l.spheres, {b});
+      worst = std::max(worst, next * std::sqrt(w2) / 2.0);
+      EXPECT_LE(next * std::sqrt(w2) / 2.0, 1.0)
+          << "round " << round << ": the step " << next << " s exceeds the critical step of bond "
+          << b.i << "-" << b.j;
+      EXPECT_LE(next * std::sqrt(w2) / 2.0, rule.safety * (1 + 1e-9))
+          << "round " << round << ": the step " << next << " s exceeds " << rule.safety
+          << " x the critical step of bond " << b.i << "-" << b.j;
+    }
+    const double net = l.bonds.empty() ? 0.0 : network_omega2(l.springs, l.spheres, l.bonds);
+    EXPECT_LE(next * std::sqrt(net) / 2.0, 1.0)
+        << "round " << round << ": the network's critical step";
+    EXPECT_LE(next * std::sqrt(net) / 2.0, rule.safety * (1 + 1e-9))
+        << "round " << round << ": the network";
+    std::printf(
+        "round %d: %zu bonds left, step %.4g s (%.3g x the first), dt omega / 2 at most %.3f "
+        "(bonds), "
+        "%.3f (network)\n",
+        round, l.bonds.size(), next, next / dt0, worst, next * std::sqrt(net) / 2.0);
+    dt = next;
+    if (l.bonds.empty()) break;
+    // A round of breaks: a third of the bonds left (all when 3 or fewer).
+    std::shuffle(l.bonds.begin(), l.bonds.end(), rng);
+    l.bonds.resize(l.bonds.size() <= 3 ? 0 : l.bonds.size() - l.bonds.size() / 3 - 1);
+    ++round;
+  }
+  EXPECT_GT(round, 3);
+  // Not vacuous: with no bond left the step reached the cap.
+  EXPECT_DOUBLE_EQ(dt, rule.dt_max);
+}
+
+// Growth is limited per re-evaluation, and a smaller bound cuts the step at once.
+TEST(StepLimit, GrowthLimitedAndShrinksAtOnce) {
+  const StepRule rule{0.5, 1e-6, 2.0};
+  EXPECT_DOUBLE_EQ(mill::step_limit::next_step(1e-8, 0.0, rule), 2e-8);   // no bonds: growth 2
+  EXPECT_DOUBLE_EQ(mill::step_limit::next_step(1e-7, 1e-7, rule), 5e-8);  // safety x bonds' step
+  EXPECT_DOUBLE_EQ(mill::step_limit::next_step(8e-7, 0.0, rule), 1e-6);   // the cap
+  EXPECT_DOUBLE_EQ(mill::step_limit::next_step(2e-6, 0.0, rule), 1e-6);   // above the cap: cut
+  EXPECT_DOUBLE_EQ(mill::step_limit::critical_step(0.0), 0.0);            // no bond: no bound
+  EXPECT_DOUBLE_EQ(mill::step_limit::critical_step(4.0), 1.0);            // omega dt = 2
+}
