@@ -169,9 +169,10 @@ ScbRun LabBench::scb(const BondParams& p, double rate, int orientations, const R
                                     {{"carve_angle", num(d.angle_deg)}}},
                                    p, rate, disc_step, d);
     // A half disc too coarse for the three-point bend has no element under
-    // the load point or over a support: its "peak" would be noise. Measured:
-    // 200-element specimens (56 elements in the half disc) leave the load
-    // point empty; 400 give 2 and 6.
+    // the load point (even with the deck's doubled arc) or over a support:
+    // its "peak" would be noise. Measured: the disc-radius half disc of
+    // 200-element specimens (56 elements) left the load point empty; at 1.2 x
+    // (about 110 elements) every orientation has one.
     for (const char* layer : {"load_layer", "support_layer"})
       if (info_at(d.info, layer, d.info_file) < 1)
         throw ScbTooCoarse(fmt::format(
