@@ -500,10 +500,9 @@ constexpr double kPi = 3.14159265358979323846;
 // Highest flywheel tip speed accepted: a steel rim's hoop stress rho v^2
 // reaches its strength (~700 MPa at 7850 kg/m^3) near 300 m/s.
 constexpr double kMaxTipSpeed = 300.0;
-// Most steps a transport run may take, and how far (x lump radius) a lump
-// at the tip speed may move in one step.
+// Most steps a transport run may take (how far a lump may move in one step:
+// kMaxLumpStepMove).
 constexpr double kMaxSteps = 1e9;
-constexpr double kMaxStepMove = 0.25;
 
 // A list key's items given twice: each one is a job (or part of a job
 // label), so a repeated item would run twice into one folder.
@@ -579,11 +578,12 @@ void check_physics(const Document& d) {
   // A lump flung at the tip speed may move a fraction of its radius per step,
   // or it passes through a beater plate between two contact checks.
   const double r_lump = d.real("injection.lump_diameter") / 2;
-  if (tip_max * dt > kMaxStepMove * r_lump)
-    fail("injection.timestep",
-         fmt::format("at the tip speed {:.0f} m/s a lump moves {:.3g} m per step, more than {:g} of its radius ({:g} m); "
-                     "expected injection.timestep <= {:.3g} s",
-                     tip_max, tip_max * dt, kMaxStepMove, r_lump, kMaxStepMove * r_lump / tip_max));
+  if (tip_max * dt > kMaxLumpStepMove * r_lump)
+    fail("injection.timestep", fmt::format("at the tip speed {:.0f} m/s a lump moves {:.3g} m per "
+                                           "step, more than {:g} of its radius ({:g} m); "
+                                           "expected injection.timestep <= {:.3g} s",
+                                           tip_max, tip_max * dt, kMaxLumpStepMove, r_lump,
+                                           kMaxLumpStepMove * r_lump / tip_max));
   if (d.real("transport.trajectory_interval") >= t_limit)
     fail("transport.trajectory_interval",
          fmt::format("expected shorter than injection.time_limit ({:g} s), got {:g} s: no trajectory point would be kept",

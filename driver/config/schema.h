@@ -68,6 +68,10 @@ std::string expected_text(const KeyDef& k);
 // deck (liggghts_inputs/lump_build.in.tmpl) places only one element in its
 // sphere, whatever the seed.
 inline constexpr long kMinLumpElements = 10;
+// Most a transported lump may move in one step at the fastest tip speed, as
+// a share of its radius, or it passes through a beater plate between two
+// contact checks (injection.timestep).
+inline constexpr double kMaxLumpStepMove = 0.25;
 // Most elements of one flat-joint interface (rings x sectors): the slots of
 // fix bond/flatjoint (liggghts_styles/flat_joint.h, kMaxElements).
 inline constexpr int kMaxJointElements = 32;

@@ -16,9 +16,9 @@ namespace fs = std::filesystem;
 
 LumpSpec lump_spec(const config::CaseConfig& cfg) {
   const auto& d = cfg.doc;
-  return {d.integer("lump.n_elements"), d.real("lump.diameter"),      d.real("lump.radius_spread"),
-          d.integer("lump.seed"),       d.real("lump.bond_gap"),      d.integer("lump.max_bonds"),
-          cfg.ore.real("density"),      cfg.ore.real("poisson_ratio")};
+  return {d.integer("lump.n_elements"), d.real("lump.diameter"),       d.real("lump.radius_spread"),
+          d.integer("lump.seed"),       d.real("lump.bond_gap"),       d.integer("lump.max_bonds"),
+          cfg.ore.real("density"),      cfg.ore.real("poisson_ratio"), ""};
 }
 
 namespace {
@@ -78,7 +78,7 @@ LumpInfo build_lump(const PackingEnv& env, const LumpSpec& s, int packing, const
 
 LumpInfo ensure_lump(const PackingEnv& env, const fs::path& cache_dir, const LumpSpec& s,
                      int packing, const std::string& requester) {
-  const std::string label = fmt::format("n{}_p{}", s.n_elements, packing);
+  const std::string label = fmt::format("n{}{}_p{}", s.n_elements, s.tag, packing);
   nlohmann::json in = {{"n_elements", s.n_elements}, {"diameter", s.diameter},
                        {"spread", s.spread},         {"seed", s.seed + packing},
                        {"bond_gap", s.bond_gap},     {"max_bonds", s.max_bonds},

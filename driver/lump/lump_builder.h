@@ -22,6 +22,9 @@ struct LumpSpec {
   long max_bonds;
   double density;
   double nu;
+  // Put in the cache label ("n40_d18.93mm_p0") of a lump that is not
+  // lump.diameter's (a feed class's); "" for lump.diameter's ("n40_p0").
+  std::string tag;
 };
 
 LumpSpec lump_spec(const config::CaseConfig& cfg);

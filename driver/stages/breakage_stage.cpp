@@ -89,17 +89,19 @@ void plan_sweep(const StageContext& ctx, const nlohmann::json& base, Plan& p) {
 // With a feed: the breakage matrix per rotor speed from the in-mill runs and
 // the closed circuit's steady state, or a warning that says what the
 // population balance needs.
-void write_population_balance(StageContext& ctx, const std::vector<JobSpec>& in_mill) {
+void write_population_balance(StageContext& ctx, const std::vector<JobSpec>& in_mill,
+                              const std::vector<JobSpec>& class_runs) {
   const auto& d = ctx.cfg.doc;
   if (d.str("breakage.conditions") != "transport" || d.integer("breakage.in_mill.lumps") <= 0 ||
-      in_mill.empty()) {
+      (in_mill.empty() && class_runs.empty())) {
     ctx.progress.warn(fmt::format(
         "{}: the feed's population balance needs in-mill runs (breakage.conditions: transport "
         "and breakage.in_mill.lumps >= 1); none ran, so there is no breakage matrix",
         d.file()));
     return;
   }
-  write_circuit(ctx, write_breakage_matrices(ctx, in_mill), read_mill_energy(ctx, in_mill));
+  write_circuit(ctx, write_breakage_matrices(ctx, in_mill, class_runs),
+                read_mill_energy(ctx, in_mill));
 }
 
 }  // namespace
@@ -178,9 +180,16 @@ Plan BreakageStage::plan(const StageContext& ctx) const {
   if (ctx.cfg.doc.str("breakage.conditions") != "transport") {
     plan_sweep(ctx, base, p);
   } else {
-    // Conditions from stage 1, and the in-mill runs, per rotor speed.
+    // Conditions from stage 1, and the in-mill runs, per rotor speed; with
+    // a feed, the in-mill runs of each feed class too.
+    std::vector<config::FeedClassRuns> classes;
+    if (ctx.cfg.feed) classes = config::plan_feed_classes(ctx.cfg.doc, *ctx.cfg.feed);
     for (double rpm : ctx.cfg.doc.reals("rotor.rpm"))
-      if (plan_binned(ctx, base, rpm, p)) plan_in_mill(ctx, rpm, p);
+      if (plan_binned(ctx, base, rpm, p)) {
+        plan_in_mill(ctx, rpm, p);
+        for (const auto& c : classes)
+          if (c.in_mill) plan_in_mill(ctx, rpm, p, &c);
+      }
   }
   // The same impacts with every further calibration set (calibrate.starts).
   plan_calibration_sets(ctx, p);
@@ -200,10 +209,14 @@ void BreakageStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pat
 }
 
 void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& all_jobs) {
-  // The single impacts make the sweep's results; the in-mill runs their own.
-  std::vector<JobSpec> jobs, in_mill, set_jobs;
+  // The single impacts make the sweep's results; the in-mill runs of
+  // lump.diameter their own, the feed classes' runs the breakage matrix.
+  std::vector<JobSpec> jobs, in_mill, class_runs, set_jobs;
   for (const auto& j : all_jobs)
-    (is_in_mill_job(j) ? in_mill : calibration_set_of(j) > 1 ? set_jobs : jobs).push_back(j);
+    (is_in_mill_job(j)           ? (in_mill_class(j) ? class_runs : in_mill)
+     : calibration_set_of(j) > 1 ? set_jobs
+                                 : jobs)
+        .push_back(j);
   if (jobs.empty()) return;
   // Conditions binned from transport each have their own speed and angle:
   // they are pooled into one curve over impact speed.
@@ -217,7 +230,7 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& all_
   write_jk_fit(ctx, c.rows, from_transport);
   plot_campaign(ctx, c, from_transport);
   if (from_transport) write_mill_product(ctx, jobs, write_in_mill_results(ctx, in_mill));
-  if (ctx.cfg.feed) write_population_balance(ctx, in_mill);
+  if (ctx.cfg.feed) write_population_balance(ctx, in_mill, class_runs);
   ctx.progress.info(fmt::format(
       "[breakage] results: {}/summary.csv, fractions.csv, size_distributions.csv, jk_fit.json, "
       "comminution_efficiency.json, breakage.h5, plots/*.png",

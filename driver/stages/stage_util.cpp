@@ -17,6 +17,13 @@ nlohmann::json case_keys(const config::Document& doc, const std::vector<std::str
 
 std::string rpm_label(double rpm) { return fmt::format("rpm{:g}", rpm); }
 
+std::filesystem::path transport_dir(const std::filesystem::path& run_dir, double rpm,
+                                    std::optional<std::size_t> feed_class) {
+  const std::filesystem::path t = run_dir / "transport";
+  return feed_class ? t / fmt::format("class_{}", *feed_class) / rpm_label(rpm)
+                    : t / rpm_label(rpm);
+}
+
 std::string impact_label(double velocity, double angle, int repeat) {
   return fmt::format("v{:g}_a{:g}_r{}", velocity, angle, repeat);
 }

@@ -2,8 +2,10 @@
 // run's energy ledger.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,12 @@ namespace mill {
 nlohmann::json case_keys(const config::Document& doc, const std::vector<std::string>& prefixes);
 // "rpm2000", "rpm1500.5": folder label of a rotor speed.
 std::string rpm_label(double rpm);
+// Where a transport run at `rpm` leaves its outputs (impacts.csv,
+// summary.json, ...): transport/<rpm label>/ for the lumps of
+// injection.lump_diameter, transport/class_<k>/<rpm label>/ for those of
+// feed class k (config/feed_classes.h).
+std::filesystem::path transport_dir(const std::filesystem::path& run_dir, double rpm,
+                                    std::optional<std::size_t> feed_class = std::nullopt);
 // "v150_a90_r0", "v4.5_a45_r2": folder label of an impact condition.
 std::string impact_label(double velocity, double angle, int repeat);
 // The energy ledger a bonded-lump deck wrote in its run folder (ledger.csv,

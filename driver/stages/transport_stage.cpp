@@ -3,18 +3,23 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <numeric>
+#include <optional>
 #include <sstream>
 
 #include "config/case_config.h"
+#include "config/feed_classes.h"
 #include "engine/liggghts.h"
 #include "geometry/mill_geometry.h"
 #include "jobs/job_store.h"
 #include "jobs/output_checks.h"
 #include "postprocess/flow_field_io.h"
 #include "postprocess/impact_stats.h"
+#include "postprocess/population_balance.h"
 #include "postprocess/transport_h5.h"
 #include "progress.h"
 #include "stages/stage_util.h"
@@ -245,29 +250,58 @@ void strike_keys(nlohmann::json& j, const post::TransportStats& st, double slidi
       "the wall, time since the contact ended)";
 }
 
+// The job of feed class k's lumps at a rotor speed: "rpm2000_class1".
+std::string class_label(double rpm, std::size_t k) {
+  return fmt::format("{}_class{}", rpm_label(rpm), k);
+}
+
+// The feed class of a job (none for the lumps of injection.lump_diameter).
+std::optional<std::size_t> feed_class_of(const JobSpec& job) {
+  if (!job.inputs.contains("feed_class")) return std::nullopt;
+  return job.inputs.at("feed_class").get<std::size_t>();
+}
+
+// Where a job's outputs go (transport_dir).
+fs::path output_dir(const StageContext& ctx, const JobSpec& job) {
+  return transport_dir(ctx.run_dir, job.inputs.at("rotor.rpm").get<double>(), feed_class_of(job));
+}
+
 }  // namespace
 
 Plan TransportStage::plan(const StageContext& ctx) const {
   Plan p;
-  for (double rpm : ctx.cfg.doc.reals("rotor.rpm")) {
+  const auto& d = ctx.cfg.doc;
+  // With a feed: the lumps of every feed class that gets a run of its own.
+  std::vector<config::FeedClassRuns> classes;
+  if (ctx.cfg.feed) classes = config::plan_feed_classes(d, *ctx.cfg.feed);
+  for (double rpm : d.reals("rotor.rpm")) {
     nlohmann::json in =
-        case_keys(ctx.cfg.doc, {"mill.", "gas.", "flow.", "sample.", "injection.", "transport."});
+        case_keys(d, {"mill.", "gas.", "flow.", "sample.", "injection.", "transport."});
     in["rotor.rpm"] = rpm;
     in["ore"] = config::ore_keys(ctx.cfg.ore);
     in["deck_version"] = kDeckVersion;
     p.jobs.push_back(
         {rpm_label(rpm), in,
-         fmt::format("{} lumps of {:g} mm through the mill at {}",
-                     ctx.cfg.doc.integer("injection.n_lumps"),
-                     ctx.cfg.doc.real("injection.lump_diameter") * 1e3, rpm_label(rpm))});
+         fmt::format("{} lumps of {:g} mm through the mill at {}", d.integer("injection.n_lumps"),
+                     d.real("injection.lump_diameter") * 1e3, rpm_label(rpm))});
+    for (const auto& c : classes) {
+      if (!c.transport) continue;
+      nlohmann::json ci = in;
+      ci["injection.lump_diameter"] = c.diameter_m;
+      ci["feed_class"] = c.cls;
+      p.jobs.push_back({class_label(rpm, c.cls), ci,
+                        fmt::format("{} lumps of {:.4g} mm (feed {}) through the mill at {}",
+                                    d.integer("injection.n_lumps"), c.diameter_m * 1e3, c.name,
+                                    rpm_label(rpm))});
+    }
   }
   return p;
 }
 
-// transport/<label>/{impacts.csv, contact_ends.csv, transport.h5, summary.json}:
-// exist and read.
+// transport/<label>/{impacts.csv, contact_ends.csv, transport.h5, summary.json}
+// (transport/class_<k>/<rpm label>/ for a feed class): exist and read.
 std::string TransportStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
-  const fs::path out = ctx.stage_dir / job.label;
+  const fs::path out = output_dir(ctx, job);
   if (auto r = jobs::first_problem(
           {jobs::check_json(out / "summary.json"), jobs::check_hdf5(out / "transport.h5"),
            jobs::check_file(out / "impacts.csv"), jobs::check_file(out / "contact_ends.csv")});
@@ -283,6 +317,18 @@ std::string TransportStage::damaged_outputs(const StageContext& ctx, const JobSp
 }
 
 namespace {
+
+// summary.json's "feed_class" of a class run: the class and its lumps.
+nlohmann::json class_json(const StageContext& ctx, std::size_t k) {
+  const config::Feed& f = ctx.cfg.feed.value();
+  const post::SizeClasses c = post::SizeClassesFromSieves(f.sizes_mm);
+  return {{"class", k},
+          {"name", c.name(k)},
+          {"lower_mm", c.lower_mm(k)},
+          {"upper_mm", c.upper_mm[k]},
+          {"mass_fraction", f.mass_fractions[c.size() - 1 - k]},
+          {"lump_diameter_mm", post::RepresentativeSize(c, k)}};
+}
 
 // The sampled gas field of the rotor speed, or MissingInput naming the
 // command that makes it.
@@ -589,12 +635,13 @@ void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pa
   TransportRun r;
   r.label = job.label;
   r.rpm = job.inputs.at("rotor.rpm").get<double>();
-  r.field_file = sampled_field(ctx, r.label, r.rpm);
-  const nlohmann::json flow_converged = check_flow_converged(ctx, r.label);
+  r.field_file = sampled_field(ctx, rpm_label(r.rpm), r.rpm);
+  const nlohmann::json flow_converged = check_flow_converged(ctx, rpm_label(r.rpm));
   // injection.time_limit > duration and the time step: checked with the case.
   r.g = geometry::MillGeometry::from_config(d);
   r.omega = r.rpm * 2 * kPi / 60.0;
-  r.diameter = d.real("injection.lump_diameter");
+  // injection.lump_diameter, or a feed class's representative size.
+  r.diameter = job.inputs.at("injection.lump_diameter").get<double>();
   r.dt = d.real("injection.timestep");
   r.density = ctx.cfg.ore.real("density");
   r.work = job_dir / "run";
@@ -602,10 +649,93 @@ void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pa
   run_transport_deck(ctx, r);
   const TransportResults t = read_transport_results(r, d.real("transport.sliding_threshold"));
   const CrossCheck x = cross_check(r, t.st.surfaces.at("flywheel"));
-  const nlohmann::json summary = transport_summary(ctx, r, t, x, flow_converged);
-  const fs::path out = ctx.stage_dir / r.label;
+  nlohmann::json summary = transport_summary(ctx, r, t, x, flow_converged);
+  if (const auto k = feed_class_of(job)) summary["feed_class"] = class_json(ctx, *k);
+  const fs::path out = output_dir(ctx, job);
   write_transport_outputs(ctx, r, t, summary, out);
   log_transport(ctx, r, t, x, out);
+}
+
+namespace {
+
+// The impact statistics of a class run that feed_classes.json and .csv keep
+// (its summary.json's keys).
+const std::vector<std::string>& class_stat_keys() {
+  static const std::vector<std::string> k = {"n_particles",
+                                             "n_exited",
+                                             "n_flywheel_impacts",
+                                             "flywheel_impacts_per_particle_mean",
+                                             "flywheel_impact_speed_mean_m_s",
+                                             "flywheel_impact_speed_std_m_s",
+                                             "flywheel_normal_speed_mean_m_s",
+                                             "flywheel_angle_mean_deg",
+                                             "n_flywheel_first_strikes",
+                                             "flywheel_first_strike_speed_mean_m_s",
+                                             "n_wall_impacts",
+                                             "wall_impact_speed_mean_m_s",
+                                             "first_impact_time_mean_s"};
+  return k;
+}
+
+}  // namespace
+
+// With a feed: transport/feed_classes.json and .csv, the impact statistics
+// of each feed class per rotor speed from its runs' summary.json, and why a
+// class has no run.
+void TransportStage::finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) {
+  if (!ctx.cfg.feed) return;
+  std::map<std::size_t, nlohmann::json> speeds;
+  std::string csv = "rpm,class,lower_mm,upper_mm,lump_diameter_mm";
+  for (const auto& k : class_stat_keys()) csv += "," + k;
+  csv += "\n";
+  for (const auto& job : jobs) {
+    const auto k = feed_class_of(job);
+    if (!k) continue;
+    const fs::path f = output_dir(ctx, job) / "summary.json";
+    std::ifstream in(f);
+    const auto s = nlohmann::json::parse(in);
+    const double rpm = job.inputs.at("rotor.rpm").get<double>();
+    const nlohmann::json c = class_json(ctx, *k);
+    nlohmann::json e = {{"rpm", rpm}, {"summary", fs::relative(f, ctx.run_dir).string()}};
+    csv += fmt::format("{:g},{},{:g},{:g},{:.6g}", rpm, *k, c.at("lower_mm").get<double>(),
+                       c.at("upper_mm").get<double>(), c.at("lump_diameter_mm").get<double>());
+    for (const auto& key : class_stat_keys()) {
+      const nlohmann::json v = s.value(key, nlohmann::json(nullptr));
+      e[key] = v;
+      csv += "," + (v.is_number() ? fmt::format("{:.9g}", v.get<double>()) : std::string());
+    }
+    csv += "\n";
+    speeds[*k].push_back(e);
+  }
+  nlohmann::json classes = nlohmann::json::array();
+  for (const auto& c : config::plan_feed_classes(ctx.cfg.doc, *ctx.cfg.feed)) {
+    nlohmann::json e = class_json(ctx, c.cls);
+    e["transport"] = c.transport;
+    if (!c.without_runs.empty() && !c.transport) e["without_runs"] = c.without_runs;
+    e["rotor_speeds"] = speeds.count(c.cls) ? speeds[c.cls] : nlohmann::json::array();
+    classes.push_back(e);
+  }
+  const nlohmann::json j = {
+      {"sizes_mm", ctx.cfg.feed->sizes_mm},
+      {"classes", classes},
+      {"definitions",
+       {{"class", "feed.sizes_mm's classes, coarsest first (class 0), each [lower, upper)"},
+        {"lump_diameter_mm",
+         "the class's representative size (geometric mean of its edges), its lumps' diameter"},
+        {"rotor_speeds", "per rotor speed, the class run's summary.json figures (SI units)"}}}};
+  jobs::atomic_write(ctx.stage_dir / "feed_classes.json", j.dump(2) + "\n");
+  jobs::atomic_write(ctx.stage_dir / "feed_classes.csv", csv);
+  ctx.progress.info(fmt::format(
+      "[transport] feed classes: {}/feed_classes.{{json,csv}} ({} class run(s))",
+      ctx.stage_dir.string(), std::count_if(jobs.begin(), jobs.end(), [](const JobSpec& j) {
+        return feed_class_of(j).has_value();
+      })));
+}
+
+std::string TransportStage::damaged_merged_outputs(const StageContext& ctx,
+                                                   const std::vector<JobSpec>&) const {
+  if (!ctx.cfg.feed) return "";
+  return jobs::check_json(ctx.stage_dir / "feed_classes.json", true);
 }
 
 }  // namespace mill

@@ -1,8 +1,11 @@
 // Stage 'transport': ore lumps through the mill in the sampled gas flow
-// (LIGGGHTS, one-way coupled), one job per rotor speed. Each job writes
-// transport/<rpm label>/{impacts.csv, contact_ends.csv, transport.h5,
-// summary.json, plots/*.png} and keeps its LIGGGHTS run (VTK dumps, log) in
-// transport/jobs/<label>/run.
+// (LIGGGHTS, one-way coupled), one job per rotor speed, and with a feed one
+// more per rotor speed and feed class (config/feed_classes.h). Each job
+// writes transport/<rpm label>/ (transport/class_<k>/<rpm label>/ for a
+// class) {impacts.csv, contact_ends.csv, transport.h5, summary.json,
+// plots/*.png} and keeps its LIGGGHTS run (VTK dumps, log) in
+// transport/jobs/<label>/run; finalize gathers the classes' statistics in
+// transport/feed_classes.{json,csv}.
 #pragma once
 
 #include "stages/stage.h"
@@ -20,6 +23,9 @@ class TransportStage : public Stage {
   void run_job(StageContext& ctx, const JobSpec& job,
                const std::filesystem::path& job_dir) override;
   std::string damaged_outputs(const StageContext& ctx, const JobSpec& job) const override;
+  void finalize(StageContext& ctx, const std::vector<JobSpec>& jobs) override;
+  std::string damaged_merged_outputs(const StageContext& ctx,
+                                     const std::vector<JobSpec>& jobs) const override;
 };
 
 }  // namespace mill

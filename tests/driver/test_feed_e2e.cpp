@@ -1,10 +1,12 @@
-// A case with a feed end to end on the tiny mill: one 40-element lump per
-// rotor speed struck in the turning mill (stage 1's strike written by hand),
-// then the feed's population balance: the breakage matrix of the lump's
-// class measured from the run's pieces, the coarser feed class scaled, and
-// the closed circuit's steady product per speed (circuit.json, circuit.csv)
-// and the lowest speed that meets feed.target_p80_mm, in the report's
-// headline.
+// A case with a feed end to end on the tiny mill: per rotor speed, one
+// 40-element lump of lump.diameter and one lump of each of the two feed
+// classes (their representative size, the calibration's element size)
+// struck in the turning mill (stage 1's strikes written by hand, one file
+// per class as the transport writes them), then the feed's population
+// balance: both feed classes' breakage columns measured from their own
+// runs' pieces, and the closed circuit's steady product per speed
+// (circuit.json, circuit.csv) and the lowest speed that meets
+// feed.target_p80_mm, in the report's headline.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -24,16 +26,29 @@ using nlohmann::json;
 const std::string kData = MILL_TEST_DATA;
 const std::vector<double> kRpm = {2000, 2500};
 
-// Per rotor speed, one lump falling at 5 m/s onto plate 0's leading face,
-// which points up at t = (pi/2) / omega (as in test_in_mill_e2e.cpp).
+// The feed classes of tiny_feed.yaml that are fed: class 0 (22.4-31.5 mm)
+// and class 1 (16-22.4 mm), their representative sizes (mm) and the
+// elements of their lumps, 40 x (size / 20 mm)^3 rounded.
+const std::vector<double> kClassMm = {std::sqrt(22.4 * 31.5), std::sqrt(16 * 22.4)};
+const std::vector<long> kClassElements = {94, 34};
+
+// Per rotor speed, one lump falling at 5 m/s onto plate 0's leading face
+// (x = -0.01 m), which points up at t = (pi/2) / omega (as in
+// test_in_mill_e2e.cpp): the lump of lump.diameter (transport/<rpm>/) and
+// one of each feed class (transport/class_<k>/<rpm>/), touching the face.
 void write_transport_impacts(const fs::path& run) {
   for (double rpm : kRpm) {
-    const fs::path d = run / fmt::format("transport/rpm{:g}", rpm);
-    fs::create_directories(d);
     const double t = 0.5 * M_PI / (rpm * 2 * M_PI / 60);
-    spit(d / "impacts.csv",
-         std::string(kImpactsCsvHeader) + tiny_strike_row(rpm, 1, t, {-0.021, 0.62, 0}, {0, -5, 0},
-                                                          {-0.01, 0.62, 0}, {-1, 0, 0}));
+    const auto write = [&](const fs::path& d, double lump_mm) {
+      fs::create_directories(d);
+      const double x = -0.0105 - 0.5e-3 * lump_mm;
+      spit(d / "impacts.csv",
+           std::string(kImpactsCsvHeader) +
+               tiny_strike_row(rpm, 1, t, {x, 0.62, 0}, {0, -5, 0}, {-0.01, 0.62, 0}, {-1, 0, 0}));
+    };
+    write(run / fmt::format("transport/rpm{:g}", rpm), 21);
+    for (size_t k = 0; k < kClassMm.size(); ++k)
+      write(run / fmt::format("transport/class_{}/rpm{:g}", k, rpm), kClassMm[k]);
   }
 }
 
@@ -62,20 +77,31 @@ class Feed : public ::testing::Test {
 fs::path* Feed::dir_ = nullptr;
 int Feed::status_ = -1;
 
-TEST_F(Feed, BreakageMatrixPerRotorSpeedFromTheInMillPieces) {
+TEST_F(Feed, BreakageMatrixPerRotorSpeedFromEachClassesOwnInMillPieces) {
   ASSERT_EQ(status_, 0) << slurp(*dir_ / "breakage.log");
   const json m = read("breakage_matrix.json");
-  // Sieves 2 .. 31.5 mm: 8 classes, coarsest first; the 20 mm lump is in
-  // class 1 (16-22.4 mm).
+  // Sieves 2 .. 31.5 mm: 8 classes, coarsest first; the feed fills classes
+  // 0 (22.4-31.5 mm) and 1 (16-22.4 mm), each measured by its own lump.
   ASSERT_EQ(m.at("classes").size(), 8u);
   ASSERT_EQ(m.at("rotor_speeds").size(), kRpm.size());
   for (const auto& s : m.at("rotor_speeds")) {
     const auto b = s.at("matrix").get<std::vector<std::vector<double>>>();
     const auto& cols = s.at("columns");
-    EXPECT_EQ(cols[1].at("origin"), "measured") << s.dump();
-    EXPECT_EQ(cols[1].at("lumps").get<int>(), 1);
-    EXPECT_EQ(cols[0].at("origin"), "scaled");
-    EXPECT_EQ(cols[0].at("scaled_from_class").get<int>(), 1);
+    for (size_t k = 0; k < 2; ++k) {
+      EXPECT_EQ(cols[k].at("origin"), "measured") << s.dump();
+      EXPECT_EQ(cols[k].at("lumps").get<int>(), 1);
+      EXPECT_NEAR(cols[k].at("lump_diameter_mm").get<double>(), kClassMm[k], 1e-9);
+      EXPECT_EQ(cols[k].at("lump_elements").get<long>(), kClassElements[k]);
+    }
+    // Classes 2-6 have no feed: scaled from the nearest measured class, 1,
+    // and they say why they were not run.
+    for (size_t j = 2; j < 7; ++j) {
+      EXPECT_EQ(cols[j].at("origin"), "scaled") << j;
+      EXPECT_EQ(cols[j].at("scaled_from_class").get<int>(), 1) << j;
+      EXPECT_NE(cols[j].at("not_measured").get<std::string>().find("of the feed"),
+                std::string::npos)
+          << cols[j].dump();
+    }
     EXPECT_EQ(cols[7].at("origin"), "finest");
     for (size_t j = 0; j < 8; ++j) {
       double sum = 0;
@@ -88,22 +114,35 @@ TEST_F(Feed, BreakageMatrixPerRotorSpeedFromTheInMillPieces) {
       }
       EXPECT_NEAR(sum, 1.0, 1e-12) << "column " << j;
     }
-    // The measured column is the run's pieces binned by size: recomputed
-    // here from its impact.h5 (d/D x 20 mm) on the sieves.
-    const fs::path job = stage() / fmt::format("jobs/rpm{:g}_mill_p1", s.at("rpm").get<double>());
-    const auto p = mill::post::ReadImpactPieces((job / "impact.h5").string());
+    // Each measured column is its class run's pieces binned by size:
+    // recomputed here from its impact.h5 (d/D x the class's size) on the sieves.
     const std::vector<double> upper = {31.5, 22.4, 16, 11.2, 8, 5.6, 4, 2};
-    std::vector<double> want(8, 0.0);
-    double total = 0;
-    for (size_t k = 0; k < p.mass_kg.size(); ++k) {
-      const double x = 20 * p.d_rel[k];
-      size_t i = 1;  // nothing coarser than the lump's class
-      while (i + 1 < 8 && x < upper[i + 1]) ++i;
-      want[i] += p.mass_kg[k];
-      total += p.mass_kg[k];
+    for (size_t k = 0; k < 2; ++k) {
+      const fs::path job =
+          stage() / fmt::format("jobs/rpm{:g}_c{}_mill_p1", s.at("rpm").get<double>(), k);
+      const auto p = mill::post::ReadImpactPieces((job / "impact.h5").string());
+      std::vector<double> want(8, 0.0);
+      double total = 0;
+      for (size_t q = 0; q < p.mass_kg.size(); ++q) {
+        const double x = kClassMm[k] * p.d_rel[q];
+        size_t i = k;  // nothing coarser than the lump's class
+        while (i + 1 < 8 && x < upper[i + 1]) ++i;
+        want[i] += p.mass_kg[q];
+        total += p.mass_kg[q];
+      }
+      for (size_t i = 0; i < 8; ++i) EXPECT_NEAR(b[i][k], want[i] / total, 1e-12) << k << " " << i;
+      // The run's lump is the class's: its element count, and packed in a
+      // sphere of the class's size (a packing of a few dozen elements
+      // fills it to 0.75-0.9 of its diameter).
+      const json run = json::parse(slurp(job / "in_mill.json"));
+      EXPECT_EQ(run.at("feed_class").get<size_t>(), k);
+      EXPECT_EQ(run.at("lump").at("elements").get<long>(), kClassElements[k]);
+      const double outer = run.at("lump").at("outer_diameter_m").get<double>();
+      EXPECT_LE(outer, 1e-3 * kClassMm[k] * (1 + 1e-9));
+      EXPECT_GE(outer, 0.7e-3 * kClassMm[k]);
     }
-    for (size_t i = 0; i < 8; ++i) EXPECT_NEAR(b[i][1], want[i] / total, 1e-12) << i;
-    // The struck lump broke: not all of it stayed in its class.
+    // The struck lumps broke: not all of either stayed in its class.
+    EXPECT_LT(b[0][0], 1.0) << s.dump();
     EXPECT_LT(b[1][1], 1.0) << s.dump();
   }
   EXPECT_NE(slurp(stage() / "breakage_matrix.csv").find("rpm,from_class,from_upper_mm"),

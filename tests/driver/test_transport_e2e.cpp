@@ -188,6 +188,52 @@ TEST_F(TinyTransport, UnconvergedFlowOverrideIsRecorded) {
   EXPECT_NE(page.find("speed of the lumps leaving the beaters"), std::string::npos);
 }
 
+// With a feed, each fed class's lumps go through the mill in a run of their
+// own (its representative size, 26.6 mm here) beside the run of
+// injection.lump_diameter, and the stage gathers the classes' impact
+// statistics in transport/feed_classes.{json,csv}.
+TEST(TinyTransportFeed, OneRunPerFedClassWithItsImpactStatistics) {
+  const fs::path dir = scratch("transport_feed");
+  std::ofstream(dir / "case.yaml")
+      << kCase << "flow: {allow_unconverged: true}\n"
+      << "feed: {sizes_mm: [16, 22.4, 31.5], mass_fractions: [0, 0, 1], rate_tph: 5, "
+         "cut_size_mm: 16}\n";
+  write_synthetic_field(dir / "run" / "sample" / "rpm2000" / "field.h5");
+  write_unconverged_sample_report(dir / "run" / "sample" / "rpm2000" / "sample_report.json");
+  const int st = orchestrate("--case " + (dir / "case.yaml").string() +
+                                 " --stage transport --output " + (dir / "run").string(),
+                             dir / "transport.log");
+  ASSERT_EQ(st, 0) << slurp(dir / "transport.log");
+  const fs::path t = dir / "run" / "transport";
+  EXPECT_TRUE(fs::exists(t / "rpm2000" / "impacts.csv"));
+  const fs::path c0 = t / "class_0" / "rpm2000";
+  for (const char* f : {"impacts.csv", "contact_ends.csv", "transport.h5", "summary.json"})
+    EXPECT_TRUE(fs::exists(c0 / f)) << f;
+  const auto s = nlohmann::json::parse(slurp(c0 / "summary.json"));
+  EXPECT_EQ(s.at("n_particles").get<long>(), 6);
+  EXPECT_EQ(s.at("feed_class").at("class").get<int>(), 0);
+  EXPECT_NEAR(s.at("feed_class").at("lump_diameter_mm").get<double>(), std::sqrt(22.4 * 31.5),
+              1e-9);
+  EXPECT_GT(s.at("n_flywheel_impacts").get<long>(), 0) << s.dump(2);
+
+  const auto j = nlohmann::json::parse(slurp(t / "feed_classes.json"));
+  ASSERT_EQ(j.at("classes").size(), 3u);
+  const auto& k0 = j.at("classes")[0];
+  EXPECT_TRUE(k0.at("transport").get<bool>());
+  ASSERT_EQ(k0.at("rotor_speeds").size(), 1u);
+  EXPECT_EQ(k0.at("rotor_speeds")[0].at("n_flywheel_impacts"), s.at("n_flywheel_impacts"));
+  EXPECT_EQ(k0.at("rotor_speeds")[0].at("flywheel_impact_speed_mean_m_s"),
+            s.at("flywheel_impact_speed_mean_m_s"));
+  for (size_t k : {1u, 2u}) {
+    EXPECT_FALSE(j.at("classes")[k].at("transport").get<bool>());
+    EXPECT_NE(j.at("classes")[k].at("without_runs").get<std::string>().find("of the feed"),
+              std::string::npos);
+  }
+  const std::string csv = slurp(t / "feed_classes.csv");
+  EXPECT_EQ(csv.rfind("rpm,class,lower_mm,upper_mm,lump_diameter_mm,n_particles", 0), 0u) << csv;
+  EXPECT_NE(csv.find("\n2000,0,22.4,31.5,26.5631,6,"), std::string::npos) << csv;
+}
+
 // Without the sample stage's field the stage fails and names the file and the command.
 TEST(TransportMissingField, NamesFileAndCommand) {
   const fs::path dir = scratch("transport_missing");

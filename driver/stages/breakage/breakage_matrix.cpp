@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "config/feed_classes.h"
 #include "jobs/job_store.h"
 #include "postprocess/breakage_results.h"
 #include "progress.h"
@@ -18,6 +19,9 @@ namespace {
 struct ClassRuns {
   std::vector<post::LumpPieces> lumps;
   double mass_kg = 0;
+  double lump_mm = 0;  // the lumps' diameter
+  long elements = 0;   // per lump
+  bool own = false;    // the class's own runs; else those of lump.diameter
 };
 
 // The pieces of an in-mill run in mm: d/D of its impact.h5 times the lump's
@@ -44,19 +48,33 @@ nlohmann::json classes_json(const post::SizeClasses& c) {
 
 }  // namespace
 
-std::map<double, post::AssembledMatrix> write_breakage_matrices(StageContext& ctx,
-                                                                const std::vector<JobSpec>& jobs) {
+std::map<double, post::AssembledMatrix> write_breakage_matrices(
+    StageContext& ctx, const std::vector<JobSpec>& in_mill,
+    const std::vector<JobSpec>& class_runs) {
   const config::Feed& feed = ctx.cfg.feed.value();
   const post::SizeClasses classes = post::SizeClassesFromSieves(feed.sizes_mm);
+  const std::vector<config::FeedClassRuns> plan = config::plan_feed_classes(ctx.cfg.doc, feed);
   const jobs::JobStore store(ctx.stage_dir);
-  const double lump_mm = 1000 * ctx.cfg.doc.real("lump.diameter");
-  const std::size_t lump_class = config::lump_feed_class(ctx.cfg.doc, feed);
   std::map<double, std::map<std::size_t, ClassRuns>> runs;
-  for (const auto& job : jobs) {
-    if (!is_in_mill_job(job)) continue;
-    ClassRuns& r = runs[job.inputs.at("rpm").get<double>()][lump_class];
-    r.lumps.push_back(job_pieces(store.job_dir(job.label), lump_mm));
+  const auto add = [&](const JobSpec& job, std::size_t k, bool own) {
+    ClassRuns& r = runs[job.inputs.at("rpm").get<double>()][k];
+    r.own = own;
+    r.lump_mm = 1000 * job.inputs.at("lump.diameter").get<double>();
+    r.elements = job.inputs.at("lump.n_elements").get<long>();
+    r.lumps.push_back(job_pieces(store.job_dir(job.label), r.lump_mm));
     for (double m : r.lumps.back().mass_kg) r.mass_kg += m;
+  };
+  for (const auto& job : class_runs) add(job, in_mill_class(job).value(), true);
+  // lump.diameter's runs measure its class where that class has no runs of
+  // its own (a class outside the transport's lumps, or too little feed).
+  if (!in_mill.empty()) {
+    const std::size_t lump_class = config::lump_feed_class(ctx.cfg.doc, feed);
+    for (const auto& job : in_mill) {
+      const auto it = runs.find(job.inputs.at("rpm").get<double>());
+      if (it != runs.end() && it->second.count(lump_class) && it->second.at(lump_class).own)
+        continue;
+      add(job, lump_class, false);
+    }
   }
   std::map<double, post::AssembledMatrix> out;
   if (runs.empty()) return out;
@@ -70,13 +88,24 @@ std::map<double, post::AssembledMatrix> write_breakage_matrices(StageContext& ct
       measured[j] = post::MeasuredBreakageColumn(classes, j, r.lumps);
     const post::AssembledMatrix a = post::AssembleBreakageMatrix(classes, measured);
     nlohmann::json columns = nlohmann::json::array();
+    std::string measured_text;
     for (std::size_t j = 0; j < classes.size(); ++j) {
       nlohmann::json col = {{"class", j}, {"origin", a.origin[j].kind}};
       if (a.origin[j].kind == "measured") {
-        col["lumps"] = by_class.at(j).lumps.size();
-        col["lump_mass_kg"] = by_class.at(j).mass_kg;
+        const ClassRuns& r = by_class.at(j);
+        col["lumps"] = r.lumps.size();
+        col["lump_mass_kg"] = r.mass_kg;
+        col["lump_diameter_mm"] = r.lump_mm;
+        col["lump_elements"] = r.elements;
+        col["runs"] = r.own ? "the class's own (its representative size)" : "lump.diameter's";
+        measured_text += fmt::format("{}{} ({} lump(s) of {:.4g} mm, {:.1f}% stays)",
+                                     measured_text.empty() ? "" : ", ", classes.name(j),
+                                     r.lumps.size(), r.lump_mm, 100 * a.b[j][j]);
       } else if (a.origin[j].kind == "scaled") {
         col["scaled_from_class"] = a.origin[j].from;
+        col["not_measured"] = plan[j].without_runs.empty()
+                                  ? std::string("no in-mill run of its own at this rotor speed")
+                                  : plan[j].without_runs;
       }
       columns.push_back(col);
       for (std::size_t i = j; i < classes.size(); ++i)
@@ -85,12 +114,9 @@ std::map<double, post::AssembledMatrix> write_breakage_matrices(StageContext& ct
                            a.origin[j].kind == "scaled" ? std::to_string(a.origin[j].from) : "");
     }
     speeds.push_back({{"rpm", rpm}, {"matrix", a.b}, {"columns", columns}});
-    const auto& m = a.b[lump_class][lump_class];
-    ctx.progress.info(fmt::format(
-        "[breakage] breakage matrix at {:g} rpm: the {} class measured by {} in-mill lump(s) "
-        "({:.1f}% stays in its class), {} class(es) scaled from it",
-        rpm, classes.name(lump_class), by_class.at(lump_class).lumps.size(), 100 * m,
-        classes.size() - 1 - by_class.size()));
+    ctx.progress.info(
+        fmt::format("[breakage] breakage matrix at {:g} rpm: measured {}; {} class(es) scaled", rpm,
+                    measured_text, classes.size() - 1 - by_class.size()));
     out[rpm] = a;
   }
   const nlohmann::json j = {
@@ -103,7 +129,9 @@ std::map<double, post::AssembledMatrix> write_breakage_matrices(StageContext& ct
          "rotor in class i; classes coarsest first (class 0 the coarsest), each [lower, upper)"},
         {"measured",
          "the in-mill runs' pieces of the class, binned by size (d/D x the lump's diameter), "
-         "summed over the runs over their mass"},
+         "summed over the runs over their mass; runs: the class's own lumps (its representative "
+         "size, the calibration's element size) or, for lump.diameter's class without runs of "
+         "its own, the lumps of lump.diameter"},
         {"scaled",
          "a normalised breakage function (Austin, Klimpel & Luckie 1984): b_ij depends on x_i / "
          "x_j only; the measured column's passing read at relative size sieve / representative "

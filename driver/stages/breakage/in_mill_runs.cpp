@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <optional>
 
 #include "engine/liggghts.h"
 #include "geometry/mill_geometry.h"
@@ -81,11 +82,26 @@ const std::vector<std::string>& csv_columns() {
 
 bool is_in_mill_job(const JobSpec& job) { return job.inputs.value("mode", "") == "in_mill"; }
 
-void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan) {
+std::optional<std::size_t> in_mill_class(const JobSpec& job) {
+  if (!job.inputs.contains("feed_class")) return std::nullopt;
+  return job.inputs.at("feed_class").get<std::size_t>();
+}
+
+void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan,
+                  const config::FeedClassRuns* cls) {
   const auto& d = ctx.cfg.doc;
   const long k = d.integer("breakage.in_mill.lumps");
   if (k <= 0) return;
-  const fs::path f = ctx.run_dir / "transport" / rpm_label(rpm) / "impacts.csv";
+  const fs::path f =
+      transport_dir(ctx.run_dir, rpm, cls ? std::optional<std::size_t>(cls->cls) : std::nullopt) /
+      "impacts.csv";
+  if (cls && !fs::exists(f))
+    throw MissingInput(fmt::format(
+        "in-mill breakage of the feed {} at {} (breakage.in_mill.lumps {}) needs {} (the "
+        "stage-1 impacts of its {:.4g} mm lumps); make it with `orchestrate --case {} --stage "
+        "transport --output {}`",
+        cls->name, rpm_label(rpm), k, f.string(), 1e3 * cls->diameter_m, d.file(),
+        ctx.run_dir.string()));
   const geometry::MillGeometry g = geometry::MillGeometry::from_config(d);
   post::RotorMotion rotor;
   rotor.omega_rad_s = omega_of(rpm);
@@ -122,6 +138,17 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan) {
   base["in_mill_deck_version"] = kInMillDeckVersion;
   base["mode"] = "in_mill";
   base["rpm"] = rpm;
+  if (cls) {
+    // The class's lump: its representative size, the element count of the
+    // calibration's element size (config/feed_classes.h).
+    base["lump.diameter"] = cls->diameter_m;
+    base["lump.n_elements"] = cls->n_elements;
+    base["feed_class"] = cls->cls;
+  }
+  const std::string prefix = cls ? fmt::format("{}_c{}", rpm_label(rpm), cls->cls) : rpm_label(rpm);
+  const std::string lumps = cls ? fmt::format(" feed {}, {:.4g} mm lump of {} elements:", cls->name,
+                                              1e3 * cls->diameter_m, cls->n_elements)
+                                : std::string(":");
   for (size_t i = 0; i < starts.size(); ++i) {
     const auto& s = starts[i];
     nlohmann::json in = base;
@@ -138,11 +165,11 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan) {
     // The run the report animates: only its inputs (and id) change.
     if (const nlohmann::json a = animation_inputs(d, plan); !a.is_null()) in["animation"] = a;
     plan.jobs.push_back(
-        {fmt::format("{}_mill_p{}", rpm_label(rpm), s.particle_id), in,
+        {fmt::format("{}_mill_p{}", prefix, s.particle_id), in,
          fmt::format(
-             "{} in-mill: lump {} of stage 1 from {:g} ms before its flywheel strike at {:.1f} "
+             "{} in-mill{} lump {} of stage 1 from {:g} ms before its flywheel strike at {:.1f} "
              "m/s ({:.0f} deg), {:g} ms in the mill{}",
-             rpm_label(rpm), s.particle_id, 1e3 * d.real("breakage.in_mill.lead_time"),
+             rpm_label(rpm), lumps, s.particle_id, 1e3 * d.real("breakage.in_mill.lead_time"),
              s.strike_speed_m_s, s.strike_angle_deg, 1e3 * d.real("breakage.in_mill.duration"),
              in.contains("animation") ? fmt::format(", animated ({} frames)", kAnimationFrames)
                                       : std::string())});
@@ -248,7 +275,7 @@ std::vector<std::pair<std::string, std::string>> in_mill_vars(
       {"housing_top", num(g.height)},
       {"t_end", num(d.real("breakage.in_mill.duration"))},
       {"early_stop", d.boolean("breakage.in_mill.early_stop") ? "1" : "0"},
-      {"stop_margin", num(d.real("lump.diameter"))},
+      {"stop_margin", num(in.at("lump.diameter").get<double>())},
       {"dt", num(d.real("breakage.timestep"))},
       {"dt_speed", num(step.dt_speed)},
       {"adaptive_step", d.boolean("breakage.adaptive_step") ? "1" : "0"},
@@ -319,6 +346,7 @@ void add_in_mill_keys(nlohmann::json& j, const config::Document& d, const nlohma
   const auto when = [](double t) { return t >= 0 ? nlohmann::json(t) : nlohmann::json(nullptr); };
   j["mode"] = "in_mill";
   j["rpm"] = in.at("rpm").get<double>();
+  if (in.contains("feed_class")) j["feed_class"] = in.at("feed_class");
   j["start"] = {
       {"particle_id", in.at("particle_id")},
       {"time_in_transport_s", in.at("start_time_s")},
@@ -390,7 +418,15 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
   const int repeat = in.at("repeat").get<int>();
   const fs::path field_file = gas_field(ctx, label, rpm);
 
-  const LumpRun lr = prepare_lump_run(ctx, repeat, out_dir, label);
+  // A feed class's lump: its own diameter and element count, cached apart.
+  std::optional<LumpSpec> spec;
+  if (in.contains("feed_class")) {
+    spec = lump_spec(ctx.cfg);
+    spec->diameter = in.at("lump.diameter").get<double>();
+    spec->n_elements = in.at("lump.n_elements").get<long>();
+    spec->tag = fmt::format("_d{:.4g}mm", 1e3 * spec->diameter);
+  }
+  const LumpRun lr = prepare_lump_run(ctx, repeat, out_dir, label, 1, spec ? &*spec : nullptr);
   const geometry::MillGeometry g = run_geometry(d, in);
   fs::create_directories(lr.work);
   const geometry::StlSet stl = geometry::write_stl_set(g, lr.work / "stl");

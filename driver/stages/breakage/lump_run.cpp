@@ -108,12 +108,13 @@ long read_long(const fs::path& f) {
 }  // namespace
 
 LumpRun prepare_lump_run(StageContext& ctx, int repeat, const fs::path& out_dir,
-                         const std::string& label, int set) {
+                         const std::string& label, int set, const LumpSpec* spec) {
   const auto& d = ctx.cfg.doc;
   LumpRun run;
   const int packing = static_cast<int>(repeat % d.integer("lump.n_packings"));
   run.lump = ensure_lump({ctx.runner, ctx.progress, ctx.cfg.project_dir},
-                         ctx.run_dir / "breakage" / "lumps", lump_spec(ctx.cfg), packing, label);
+                         ctx.run_dir / "breakage" / "lumps", spec ? *spec : lump_spec(ctx.cfg),
+                         packing, label);
   run.bond = bond_params_for_set(ctx.cfg, ctx.run_dir, set);
   run.rotation = random_rotation(
       1469598103ULL * static_cast<unsigned long long>(d.integer("lump.seed")) + 7919ULL * repeat);

@@ -34,9 +34,10 @@ struct LumpRun {
 // Builds (or reuses) the lump of repeat `repeat` (packing repeat mod
 // lump.n_packings), its random orientation (from lump.seed and the repeat)
 // and an empty run folder out_dir/run, with the bond parameters of
-// calibration set `set` (1: the primary; lump/material.h).
+// calibration set `set` (1: the primary; lump/material.h). The lump is the
+// case's (lump_spec) unless `spec` is given (a feed class's lump).
 LumpRun prepare_lump_run(StageContext& ctx, int repeat, const std::filesystem::path& out_dir,
-                         const std::string& label, int set = 1);
+                         const std::string& label, int set = 1, const LumpSpec* spec = nullptr);
 
 // -var pairs every lump deck takes: the shared deck pieces' folder, the lump
 // file, its orientation, the bonding rule, the ore and the bonds.

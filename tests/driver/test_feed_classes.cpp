@@ -1,0 +1,147 @@
+// The runs of a feed's size classes (config/feed_classes.h): which classes
+// get a transport run and in-mill runs of their own, their lumps' diameter
+// and element count, and why the others have none; on hand-made feeds.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "config/case_config.h"
+#include "config/feed_classes.h"
+
+using mill::config::case_schema;
+using mill::config::Document;
+using mill::config::FeedClassRuns;
+using mill::config::plan_feed_classes;
+using mill::config::read_feed;
+
+namespace {
+
+Document parse(const std::string& text) { return Document::parse(text, "f.yaml", case_schema()); }
+
+std::vector<FeedClassRuns> plan(const std::string& text) {
+  const Document d = parse(text);
+  return plan_feed_classes(d, read_feed(d).value());
+}
+
+// Six classes on the default mill (1 m flywheel, 0.3 m hub and inlet, 2000
+// rpm, 5e-6 s transport step): 31.5-63, 16-31.5, 8-16, 4-8, 2-4 and the pan
+// (below 2 mm); the 4-8 mm class has no feed.
+const std::string kSixClasses =
+    "name: t\n"
+    "lump: {n_elements: 3344, diameter: 0.04}\n"
+    "breakage: {conditions: transport, in_mill: {lumps: 4}}\n"
+    "feed:\n"
+    "  sizes_mm: [2, 4, 8, 16, 31.5, 63]\n"
+    "  mass_fractions: [0.05, 0.05, 0, 0.3, 0.5, 0.1]\n"
+    "  rate_tph: 20\n"
+    "  cut_size_mm: 8\n";
+
+TEST(FeedClasses, RunsForEveryFedClassThatTheTransportTakes) {
+  const auto p = plan(kSixClasses);
+  ASSERT_EQ(p.size(), 6u);
+  const std::vector<double> upper = {63, 31.5, 16, 8, 4, 2};
+  const std::vector<double> fraction = {0.1, 0.5, 0.3, 0, 0.05, 0.05};
+  for (size_t i = 0; i < p.size(); ++i) {
+    EXPECT_EQ(p[i].cls, i);
+    EXPECT_NEAR(p[i].mass_fraction, fraction[i], 1e-15) << i;
+    // The representative size: the geometric mean of the edges; the pan's
+    // lower edge continues the series of the two finest sieves (1 mm).
+    const double lower = i + 1 < p.size() ? upper[i + 1] : 1.0;
+    EXPECT_NEAR(p[i].diameter_m, 1e-3 * std::sqrt(upper[i] * lower), 1e-15) << i;
+  }
+  // 31.5-63, 16-31.5 and 8-16 mm: transport and in-mill runs.
+  for (size_t i : {0u, 1u, 2u}) {
+    EXPECT_TRUE(p[i].transport) << i;
+    EXPECT_TRUE(p[i].in_mill) << i;
+    EXPECT_EQ(p[i].without_runs, "") << i;
+  }
+  // 4-8 mm: no feed.
+  EXPECT_FALSE(p[3].transport);
+  EXPECT_FALSE(p[3].in_mill);
+  EXPECT_NE(p[3].without_runs.find("0% of the feed"), std::string::npos) << p[3].without_runs;
+  // 2-4 mm (2.83 mm): at 105 m/s a step of 5e-6 s moves it more than a
+  // quarter of its radius; the message names the key and the step that would do.
+  EXPECT_FALSE(p[4].transport);
+  EXPECT_NE(p[4].without_runs.find("injection.timestep"), std::string::npos) << p[4].without_runs;
+  EXPECT_NE(p[4].without_runs.find("3.38e-06"), std::string::npos) << p[4].without_runs;
+  // The pan (1.41 mm): below the smallest lump the transport takes.
+  EXPECT_FALSE(p[5].transport);
+  EXPECT_NE(p[5].without_runs.find("injection.lump_diameter in [0.002, 0.5] m"), std::string::npos)
+      << p[5].without_runs;
+}
+
+TEST(FeedClasses, ElementCountKeepsTheCalibratedElementSize) {
+  const auto p = plan(kSixClasses);
+  // n = 3344 (d / 40 mm)^3, rounded: the element size of lump.diameter's lump.
+  for (size_t i : {0u, 1u, 2u}) {
+    const double ratio = p[i].diameter_m / 0.04;
+    EXPECT_EQ(p[i].n_elements, std::lround(3344 * ratio * ratio * ratio)) << i;
+    EXPECT_NEAR(p[i].element_size, 1.0, 2e-3) << i;  // rounding of the count only
+  }
+  EXPECT_EQ(p[0].n_elements, 4619);  // 44.5 mm
+  EXPECT_EQ(p[2].n_elements, 76);    // 11.3 mm
+}
+
+TEST(FeedClasses, ElementCountIsCappedAndFloored) {
+  // A 10 mm, 100-element lump: the 44.5 mm class would need 8840 elements;
+  // it gets the cap, 8 x 100, and elements 4.45 / 2 = 2.23 times as large.
+  auto text = kSixClasses;
+  text.replace(text.find("{n_elements: 3344, diameter: 0.04}"), 34,
+               "{n_elements: 100, diameter: 0.01}");
+  auto p = plan(text);
+  EXPECT_EQ(p[0].n_elements, 800);
+  EXPECT_NEAR(p[0].element_size, (p[0].diameter_m / 0.01) / 2, 1e-12);
+  // A 10-element lump of 40 mm: the 11.3 mm class gets the fewest a lump
+  // may have (10), finer elements than the calibration's.
+  text = kSixClasses;
+  text.replace(text.find("n_elements: 3344"), 16, "n_elements: 10");
+  p = plan(text);
+  EXPECT_EQ(p[2].n_elements, 10);
+  EXPECT_LT(p[2].element_size, 1.0);
+}
+
+TEST(FeedClasses, WithoutInMillLumpsOnlyTheTransportRuns) {
+  auto text = kSixClasses;
+  text.replace(text.find("in_mill: {lumps: 4}"), 19, "in_mill: {lumps: 0}");
+  const auto p = plan(text);
+  for (size_t i : {0u, 1u, 2u}) {
+    EXPECT_TRUE(p[i].transport) << i;
+    EXPECT_FALSE(p[i].in_mill) << i;
+    EXPECT_NE(p[i].without_runs.find("breakage.in_mill.lumps"), std::string::npos);
+  }
+}
+
+TEST(FeedClasses, TheFinestClassIsTransportedButNotBroken) {
+  // 0-8 mm (the pan, 5.66 mm) is fed and the transport takes it; no sieve
+  // sees its breakage, so it has no in-mill runs.
+  const auto p = plan(
+      "name: t\nlump: {diameter: 0.02}\nbreakage: {conditions: transport, in_mill: {lumps: 2}}\n"
+      "feed: {sizes_mm: [8, 16, 31.5], mass_fractions: [0.2, 0.3, 0.5], rate_tph: 5, "
+      "cut_size_mm: 8}\n");
+  ASSERT_EQ(p.size(), 3u);
+  EXPECT_TRUE(p[2].transport);
+  EXPECT_FALSE(p[2].in_mill);
+  EXPECT_NE(p[2].without_runs.find("the finest class"), std::string::npos);
+  EXPECT_TRUE(p[0].in_mill);
+  EXPECT_TRUE(p[1].in_mill);
+}
+
+// The tiny mill of the e2e tests (0.5 m flywheel, 0.15 m hub: 0.175 m
+// plates, 0.15 m inlet) refuses a class whose lumps would not pass its inlet.
+TEST(FeedClasses, ALumpThatDoesNotPassTheInletHasNoRuns) {
+  const auto p = plan(
+      "name: t\n"
+      "mill: {housing: {height: 1.2, width: 0.8, depth: 0.3}, flywheel: {diameter: 0.5, "
+      "hub_diameter: 0.15, n_plates: 4, plate_width: 0.2, plate_thickness: 0.02, axis_height: "
+      "0.45}, inlet: {center_x: -0.15, size: 0.15}, outlet: {center_x: 0.0, size: 0.3}}\n"
+      "lump: {diameter: 0.02}\nbreakage: {conditions: transport, in_mill: {lumps: 1}}\n"
+      "feed: {sizes_mm: [8, 16, 31.5, 125, 200], mass_fractions: [0, 0.5, 0.3, 0, 0.2], "
+      "rate_tph: 5, cut_size_mm: 8}\n");
+  ASSERT_EQ(p.size(), 5u);
+  EXPECT_FALSE(p[0].transport);  // 125-200 mm: 158 mm, wider than the 0.15 m inlet
+  EXPECT_NE(p[0].without_runs.find("mill.inlet.size"), std::string::npos) << p[0].without_runs;
+  EXPECT_TRUE(p[2].in_mill);  // 16-31.5 mm
+  EXPECT_TRUE(p[3].in_mill);  // 8-16 mm
+}
+
+}  // namespace
