@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -45,4 +46,25 @@ TEST(ScbDiscs, OneDiscHasNoErrorAndACappedDiscMarksTheTest) {
   EXPECT_EQ(one.summary(), "0.700 MPa m^0.5 (one half disc)");
   EXPECT_FALSE(ScbRun::of({disc(0.7e6, 90, 2, true), disc(0.6e6, 80, 2, false)}).peaked);
   EXPECT_THROW(ScbRun::of({}), std::logic_error);
+}
+
+// A half disc with no element under its load point (or over a support) is
+// named, with the file, the layer and calibrate.n_elements; one with both is
+// accepted.
+TEST(ScbDiscs, TooCoarseHalfDiscIsNamed) {
+  const std::map<std::string, double> ok = {{"atoms", 120}, {"load_layer", 1}, {"support_layer", 3}};
+  EXPECT_NO_THROW(check_scb_layers(ok, "runs/scb/scb_info.txt"));
+  for (const char* layer : {"load_layer", "support_layer"}) {
+    auto bad = ok;
+    bad[layer] = 0;
+    try {
+      check_scb_layers(bad, "runs/scb_o3/scb_info.txt");
+      FAIL() << layer << ": accepted";
+    } catch (const ScbTooCoarse& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("runs/scb_o3/scb_info.txt"), std::string::npos) << m;
+      EXPECT_NE(m.find(std::string("no element in its ") + layer), std::string::npos) << m;
+      EXPECT_NE(m.find("calibrate.n_elements"), std::string::npos) << m;
+    }
+  }
 }

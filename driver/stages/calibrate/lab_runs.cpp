@@ -144,6 +144,23 @@ TriaxialRun LabBench::triaxial(const BondParams& p, double rate, double pressure
   return t;
 }
 
+// A half disc too coarse for the three-point bend has no element under the
+// load point (even with the deck's doubled arc) or over a support: its
+// "peak" would be noise. Measured: the disc-radius half disc of
+// 200-element specimens (56 elements) left the load point empty; at 1.2 x
+// (about 110 elements) every orientation has one.
+void check_scb_layers(const std::map<std::string, double>& info,
+                      const std::filesystem::path& info_file) {
+  for (const char* layer : {"load_layer", "support_layer"})
+    if (info_at(info, layer, info_file) < 1)
+      throw ScbTooCoarse(fmt::format(
+          "{}: the semi-circular bend specimen ({:g} elements) has no element in its {} "
+          "(load_layer {:g}, support_layer {:g}): calibrate.n_elements is too few for the "
+          "toughness test; use at least 400, or drop fracture_toughness from the ore card",
+          info_file.string(), info_at(info, "atoms", info_file), layer,
+          info_at(info, "load_layer", info_file), info_at(info, "support_layer", info_file)));
+}
+
 // The semi-circular bend test: `orientations` half discs of kScbRadiusFactor
 // x the Brazilian disc's carve radius, each carved from the ball turned by
 // 180 deg / orientations more about the load axis (the notch planes then cut
@@ -168,20 +185,7 @@ ScbRun LabBench::scb(const BondParams& p, double rate, int orientations, const R
                                     10.0,
                                     {{"carve_angle", num(d.angle_deg)}}},
                                    p, rate, disc_step, d);
-    // A half disc too coarse for the three-point bend has no element under
-    // the load point (even with the deck's doubled arc) or over a support:
-    // its "peak" would be noise. Measured: the disc-radius half disc of
-    // 200-element specimens (56 elements) left the load point empty; at 1.2 x
-    // (about 110 elements) every orientation has one.
-    for (const char* layer : {"load_layer", "support_layer"})
-      if (info_at(d.info, layer, d.info_file) < 1)
-        throw ScbTooCoarse(fmt::format(
-            "{}: the semi-circular bend specimen ({:g} elements) has no element in its {} "
-            "(load_layer {:g}, support_layer {:g}): calibrate.n_elements is too few for the "
-            "toughness test; use at least 400, or drop fracture_toughness from the ore card",
-            d.info_file.string(), info_at(d.info, "atoms", d.info_file), layer,
-            info_at(d.info, "load_layer", d.info_file),
-            info_at(d.info, "support_layer", d.info_file)));
+    check_scb_layers(d.info, d.info_file);
     d.curve = post::ReadLoadCurve((work / "scb_curve.txt").string());
     d.r = post::AnalyseScb(
         d.curve, info_at(d.info, "radius", d.info_file), info_at(d.info, "thickness", d.info_file),

@@ -95,6 +95,12 @@ struct ScbTooCoarse : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Throws ScbTooCoarse, naming the info file, calibrate.n_elements and the
+// way out, when a half disc's info line (scb.in.tmpl) has no element in its
+// load_layer or support_layer.
+void check_scb_layers(const std::map<std::string, double>& info,
+                      const std::filesystem::path& info_file);
+
 // One run of a lab test: its folder <dir>/runs/<tag>, what the progress line
 // shows, and the fraction of the job done before it.
 struct RunStep {
