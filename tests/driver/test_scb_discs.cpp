@@ -52,7 +52,8 @@ TEST(ScbDiscs, OneDiscHasNoErrorAndACappedDiscMarksTheTest) {
 // named, with the file, the layer and calibrate.n_elements; one with both is
 // accepted.
 TEST(ScbDiscs, TooCoarseHalfDiscIsNamed) {
-  const std::map<std::string, double> ok = {{"atoms", 120}, {"load_layer", 1}, {"support_layer", 3}};
+  const std::map<std::string, double> ok = {
+      {"atoms", 120}, {"load_layer", 1}, {"support_layer", 3}};
   EXPECT_NO_THROW(check_scb_layers(ok, "runs/scb/scb_info.txt"));
   for (const char* layer : {"load_layer", "support_layer"}) {
     auto bad = ok;
