@@ -181,12 +181,19 @@ Plan BreakageStage::plan(const StageContext& ctx) const {
     plan_sweep(ctx, base, p);
   } else {
     // Conditions from stage 1, and the in-mill runs, per rotor speed; with
-    // a feed, the in-mill runs of each feed class too.
+    // a feed, the in-mill runs of each feed class too, and lump.diameter's
+    // own in-mill runs only when its class has none (they would measure the
+    // same class at nearly the same size twice).
     std::vector<config::FeedClassRuns> classes;
-    if (ctx.cfg.feed) classes = config::plan_feed_classes(ctx.cfg.doc, *ctx.cfg.feed);
+    bool lump_runs = true;
+    if (ctx.cfg.feed) {
+      classes = config::plan_feed_classes(ctx.cfg.doc, *ctx.cfg.feed);
+      if (ctx.cfg.doc.integer("breakage.in_mill.lumps") > 0)
+        lump_runs = !classes.at(config::lump_feed_class(ctx.cfg.doc, *ctx.cfg.feed)).in_mill;
+    }
     for (double rpm : ctx.cfg.doc.reals("rotor.rpm"))
       if (plan_binned(ctx, base, rpm, p)) {
-        plan_in_mill(ctx, rpm, p);
+        if (lump_runs) plan_in_mill(ctx, rpm, p);
         for (const auto& c : classes)
           if (c.in_mill) plan_in_mill(ctx, rpm, p, &c);
       }
@@ -229,8 +236,23 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& all_
   write_size_distributions(ctx, c.fractions);
   write_jk_fit(ctx, c.rows, from_transport);
   plot_campaign(ctx, c, from_transport);
-  if (from_transport) write_mill_product(ctx, jobs, write_in_mill_results(ctx, in_mill));
-  if (ctx.cfg.feed) write_population_balance(ctx, in_mill, class_runs);
+  if (from_transport) {
+    std::vector<JobSpec> all_in_mill = in_mill;
+    all_in_mill.insert(all_in_mill.end(), class_runs.begin(), class_runs.end());
+    publish_animation(ctx, all_in_mill);
+    // The in-mill product of product.json: lump.diameter's runs or, when
+    // its feed class ran instead (plan), that class's runs.
+    std::vector<JobSpec> lump_runs = in_mill;
+    if (lump_runs.empty() && ctx.cfg.feed && !class_runs.empty()) {
+      const std::size_t lc = config::lump_feed_class(ctx.cfg.doc, *ctx.cfg.feed);
+      for (const auto& j : class_runs)
+        if (in_mill_class(j) == lc) lump_runs.push_back(j);
+    }
+    write_mill_product(ctx, jobs, write_in_mill_results(ctx, lump_runs));
+    if (ctx.cfg.feed) write_population_balance(ctx, lump_runs, class_runs);
+  } else if (ctx.cfg.feed) {
+    write_population_balance(ctx, in_mill, class_runs);
+  }
   ctx.progress.info(fmt::format(
       "[breakage] results: {}/summary.csv, fractions.csv, size_distributions.csv, jk_fit.json, "
       "comminution_efficiency.json, breakage.h5, plots/*.png",

@@ -1,7 +1,7 @@
-// A case with a feed end to end on the tiny mill: per rotor speed, one
-// 40-element lump of lump.diameter and one lump of each of the two feed
-// classes (their representative size, the calibration's element size)
-// struck in the turning mill (stage 1's strikes written by hand, one file
+// A case with a feed end to end on the tiny mill: per rotor speed, one lump
+// of each of the two feed classes (their representative size, the
+// calibration's element size; lump.diameter's class is one of them, so
+// lump.diameter's own in-mill runs are not planned) struck in the turning mill (stage 1's strikes written by hand, one file
 // per class as the transport writes them), then the feed's population
 // balance: both feed classes' breakage columns measured from their own
 // runs' pieces, and the closed circuit's steady product per speed
@@ -149,6 +149,32 @@ TEST_F(Feed, BreakageMatrixPerRotorSpeedFromEachClassesOwnInMillPieces) {
             std::string::npos);
 }
 
+TEST_F(Feed, LumpDiametersClassRunsStandForItsOwnInMillRuns) {
+  ASSERT_EQ(status_, 0) << slurp(*dir_ / "breakage.log");
+  // lump.diameter, 20 mm, lies in class 1 (16-22.4 mm), which runs its own
+  // lumps: lump.diameter's in-mill runs are not planned beside them, and
+  // product.json's in-mill product is that class's runs, in mm of its size.
+  for (double rpm : kRpm) {
+    EXPECT_FALSE(fs::exists(stage() / fmt::format("jobs/rpm{:g}_mill_p1", rpm))) << rpm;
+    EXPECT_TRUE(fs::exists(stage() / fmt::format("jobs/rpm{:g}_c1_mill_p1/in_mill.json", rpm)));
+  }
+  const json prod = read("product.json");
+  ASSERT_EQ(prod.size(), kRpm.size());
+  for (const auto& e : prod) {
+    ASSERT_TRUE(e.contains("in_mill")) << e.dump(2);
+    const json& m = e.at("in_mill");
+    EXPECT_EQ(m.at("feed_class").get<size_t>(), 1u);
+    EXPECT_EQ(m.at("lumps").get<int>(), 1);
+    EXPECT_NEAR(m.at("lump_diameter_mm").get<double>(), kClassMm[1], 1e-9);
+    // Its sieves are the size-fraction edges times the class lump's size.
+    const auto sieves = m.at("sieves_mm").get<std::vector<double>>();
+    const auto edges = e.at("fraction_edges_rel").get<std::vector<double>>();
+    ASSERT_EQ(sieves.size() + 1, edges.size());
+    for (size_t k = 0; k < sieves.size(); ++k)
+      EXPECT_NEAR(sieves[k], kClassMm[1] * edges[k + 1], 1e-9 * kClassMm[1]) << k;
+  }
+}
+
 TEST_F(Feed, ClosedCircuitPerRotorSpeedWithProductP80LoadAndResidual) {
   ASSERT_EQ(status_, 0) << slurp(*dir_ / "breakage.log");
   const json c = read("circuit.json");
@@ -252,8 +278,10 @@ TEST_F(Feed, EnergyPerTonneAgainstItsClosedForm) {
   const json c = read("circuit.json");
   for (const auto& e : c.at("rotor_speeds")) {
     const double rpm = e.at("rpm").get<double>();
+    // lump.diameter (20 mm) lies in class 1, which has runs of its own:
+    // they stand for the lump's runs (none of lump.diameter's own ran).
     const json run =
-        json::parse(slurp(stage() / fmt::format("jobs/rpm{:g}_mill_p1/in_mill.json", rpm)));
+        json::parse(slurp(stage() / fmt::format("jobs/rpm{:g}_c1_mill_p1/in_mill.json", rpm)));
     const double w = run.at("energy").at("work_beater_J").get<double>() /
                      run.at("element_mass_kg").get<double>();  // J per kg
     ASSERT_GT(w, 0.0) << run.dump(2);

@@ -471,13 +471,12 @@ std::string damaged_in_mill_outputs(const JobSpec& job, const fs::path& dir) {
 
 std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
                                                        const std::vector<JobSpec>& jobs) {
-  publish_animation(ctx, jobs);
   const jobs::JobStore store(ctx.stage_dir);
   const auto edges = ctx.cfg.doc.reals("breakage.size_fraction_edges");
-  const double d_mm = 1000 * ctx.cfg.doc.real("lump.diameter");
-  const auto sieves = sieves_mm(edges, d_mm);
   struct Acc {
     int n = 0;
+    double lump_mm = 0;                // the runs' lump diameter
+    std::optional<std::size_t> cls;    // the feed class whose runs these are
     std::vector<double> frac;
     double single = 0, largest = 0, t10 = 0;
     bool resolved = true;
@@ -495,7 +494,11 @@ std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
     const auto j = nlohmann::json::parse(jf);
     const double rpm = job.inputs.at("rpm").get<double>();
     Acc& a = by_rpm[rpm];
-    if (a.frac.empty()) a.frac.assign(edges.size() - 1, 0.0);
+    if (a.frac.empty()) {
+      a.frac.assign(edges.size() - 1, 0.0);
+      a.lump_mm = 1000 * job.inputs.value("lump.diameter", ctx.cfg.doc.real("lump.diameter"));
+      a.cls = in_mill_class(job);
+    }
     for (const auto& f : post::ReadFractionsCsv((jd / "fractions.csv").string()))
       if (f.index < static_cast<int>(a.frac.size())) a.frac[f.index] += f.mass_fraction;
     ++a.n;
@@ -554,10 +557,17 @@ std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
           {"inlet", a.inlet / n}}},
         {"duration_s", ctx.cfg.doc.real("breakage.in_mill.duration")},
         {"early_stop", ctx.cfg.doc.boolean("breakage.in_mill.early_stop")},
+        {"lump_diameter_mm", a.lump_mm},
+        {"feed_class", a.cls ? nlohmann::json(*a.cls) : nlohmann::json(nullptr)},
         {"note",
-         "bonded lumps run in the turning mill from their first flywheel strike in stage 1: "
-         "the strike, the flight and the housing impacts (breakage/in_mill.csv per run)"}};
-    e.update(passing_json(sieves, a.frac));
+         a.cls ? "bonded lumps of lump.diameter's feed class (its representative size, "
+                 "lump_diameter_mm) run in the turning mill from their first flywheel strike in "
+                 "stage 1: the strike, the flight and the housing impacts (breakage/in_mill.csv "
+                 "per run)"
+               : "bonded lumps run in the turning mill from their first flywheel strike in stage "
+                 "1: the strike, the flight and the housing impacts (breakage/in_mill.csv per "
+                 "run)"}};
+    e.update(passing_json(sieves_mm(edges, a.lump_mm), a.frac));
     out[rpm] = e;
     ctx.progress.info(fmt::format(
         "[breakage] in-mill product at {:g} rpm ({} lump{}): fully shredded {:.1f}% of the mass, "

@@ -42,10 +42,12 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job,
 // The outputs run_in_mill writes for `job` exist and parse: "" or the reason.
 std::string damaged_in_mill_outputs(const JobSpec& job, const std::filesystem::path& dir);
 
-// breakage/in_mill.csv (one row per run), breakage/animation/ (the animated
-// run's, in_mill_animation.h) and, per rotor speed, the in-mill product
-// object of product.json (averaged over the runs); `jobs` are the runs of
-// lump.diameter's lumps (the sizes in mm are d/D x lump.diameter).
+// breakage/in_mill.csv (one row per run) and, per rotor speed, the in-mill
+// product object of product.json (averaged over the runs); `jobs` are the
+// runs of lump.diameter's lumps or, with a feed whose class of lump.diameter
+// has runs of its own, that class's runs (plan_in_mill does not plan both):
+// the sizes in mm are d/D x the runs' lump diameter (their `lump.diameter`
+// input, else the case's).
 std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
                                                        const std::vector<JobSpec>& jobs);
 
