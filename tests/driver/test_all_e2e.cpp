@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <cctype>
+#include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -85,8 +86,9 @@ TEST(WholeWorkflow, StageAllKilledMidBreakageResumesWithoutRedoingJobs) {
     ASSERT_EQ(after.count(f), 1u) << f;
     EXPECT_EQ(after.at(f), t) << "redone after the kill: " << f;
   }
-  EXPECT_EQ(breakage_jobs(run, State::Done).size(), 4u) << slurp(dir / "resumed.log");  // 2 bins x 2 repeats
-  EXPECT_NE(slurp(dir / "resumed.log").find("breakage: 4 jobs, " + std::to_string(done_before.size()) + " already done"),
+  // 2 bins x 2 repeats, and one in-mill lump of each of the two feed classes.
+  EXPECT_EQ(breakage_jobs(run, State::Done).size(), 6u) << slurp(dir / "resumed.log");
+  EXPECT_NE(slurp(dir / "resumed.log").find("breakage: 6 jobs, " + std::to_string(done_before.size()) + " already done"),
             std::string::npos)
       << slurp(dir / "resumed.log");
 
@@ -147,6 +149,52 @@ TEST(WholeWorkflow, StageAllKilledMidBreakageResumesWithoutRedoingJobs) {
   const size_t open = html.rfind("<details>", raw), close = html.rfind("</details>", raw);
   ASSERT_NE(open, std::string::npos);
   EXPECT_TRUE(close == std::string::npos || close < open) << "flow_summary.json is not inside a <details> block";
+
+  // The feed through the whole chain: each of its two classes through the
+  // real transport (its own lumps in the sampled flow), struck in the
+  // turning mill from its own first strikes, its column of the breakage
+  // matrix measured, the closed circuit solved and its decision in the
+  // report's headline.
+  const auto fc = nlohmann::json::parse(slurp(run / "transport/feed_classes.json")).at("classes");
+  const std::vector<double> class_mm = {std::sqrt(22.4 * 31.5), std::sqrt(16 * 22.4)};
+  for (size_t k = 0; k < 2; ++k) {
+    ASSERT_TRUE(fc[k].at("transport").get<bool>()) << fc[k].dump(2);
+    EXPECT_NEAR(fc[k].at("lump_diameter_mm").get<double>(), class_mm[k], 1e-9);
+    const auto cs = nlohmann::json::parse(
+        slurp(run / fmt::format("transport/class_{}/rpm2000/summary.json", k)));
+    EXPECT_EQ(cs.at("n_particles").get<int>(), 6);
+    EXPECT_GT(cs.at("n_flywheel_impacts").get<int>(), 0) << "class " << k;
+    EXPECT_EQ(fc[k].at("rotor_speeds")[0].at("n_flywheel_impacts"), cs.at("n_flywheel_impacts"));
+    // One in-mill run of the class, from one of its own lumps' strikes.
+    int runs = 0;
+    for (const auto& e : fs::directory_iterator(run / "breakage/jobs"))
+      if (e.path().filename().string().rfind(fmt::format("rpm2000_c{}_mill_p", k), 0) == 0) {
+        ++runs;
+        const auto m = nlohmann::json::parse(slurp(e.path() / "in_mill.json"));
+        EXPECT_EQ(m.at("feed_class").get<size_t>(), k);
+      }
+    EXPECT_EQ(runs, 1) << "class " << k;
+  }
+  // lump.diameter (20 mm) is in class 1, which ran its own lumps: none of
+  // lump.diameter's own in-mill runs.
+  for (const auto& e : fs::directory_iterator(run / "breakage/jobs"))
+    EXPECT_EQ(e.path().filename().string().rfind("rpm2000_mill_p", 0), std::string::npos)
+        << e.path();
+  const auto bm = nlohmann::json::parse(slurp(run / "breakage/breakage_matrix.json"));
+  const auto& cols = bm.at("rotor_speeds")[0].at("columns");
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(cols[k].at("origin"), "measured") << cols[k].dump();
+    EXPECT_EQ(cols[k].at("runs"), "the class's own (its representative size)");
+  }
+  const auto circuit = nlohmann::json::parse(slurp(run / "breakage/circuit.json"));
+  const auto& c0 = circuit.at("rotor_speeds")[0];
+  ASSERT_TRUE(c0.at("steady").get<bool>()) << c0.dump(2);
+  EXPECT_LE(c0.at("mass_balance_residual").get<double>(), 1e-9);
+  const std::string sentence = circuit.at("decision").at("sentence").get<std::string>();
+  EXPECT_NE(headline.find("lowest rotor speed for a product P80 &lt;= 6 mm"), std::string::npos)
+      << headline;
+  EXPECT_NE(headline.find(sentence), std::string::npos) << sentence;
+  EXPECT_EQ(h.at("circuit_decision").at("sentence"), sentence);
   keep_run(run);  // a finished run for e2e.compare and report.browser
 }
 
