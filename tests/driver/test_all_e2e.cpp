@@ -4,9 +4,8 @@
 // calibrate, breakage at the transport's impact conditions, report), killed
 // with SIGTERM mid-breakage and rerun: the rerun finishes without redoing any
 // job that had finished (checked by the jobs' STATUS modification times).
-#include <gtest/gtest.h>
-
 #include <fmt/format.h>
+#include <gtest/gtest.h>
 
 #include <cctype>
 #include <cmath>
@@ -88,7 +87,8 @@ TEST(WholeWorkflow, StageAllKilledMidBreakageResumesWithoutRedoingJobs) {
   }
   // 2 bins x 2 repeats, and one in-mill lump of each of the two feed classes.
   EXPECT_EQ(breakage_jobs(run, State::Done).size(), 6u) << slurp(dir / "resumed.log");
-  EXPECT_NE(slurp(dir / "resumed.log").find("breakage: 6 jobs, " + std::to_string(done_before.size()) + " already done"),
+  EXPECT_NE(slurp(dir / "resumed.log")
+                .find("breakage: 6 jobs, " + std::to_string(done_before.size()) + " already done"),
             std::string::npos)
       << slurp(dir / "resumed.log");
 

@@ -1,8 +1,8 @@
 // A case with a feed end to end on the tiny mill: per rotor speed, one lump
 // of each of the two feed classes (their representative size, the
 // calibration's element size; lump.diameter's class is one of them, so
-// lump.diameter's own in-mill runs are not planned) struck in the turning mill (stage 1's strikes written by hand, one file
-// per class as the transport writes them), then the feed's population
+// lump.diameter's own in-mill runs are not planned) struck in the turning mill (stage 1's strikes
+// written by hand, one file per class as the transport writes them), then the feed's population
 // balance: both feed classes' breakage columns measured from their own
 // runs' pieces, and the closed circuit's steady product per speed
 // (circuit.json, circuit.csv) and the lowest speed that meets

@@ -475,8 +475,8 @@ std::map<double, nlohmann::json> write_in_mill_results(StageContext& ctx,
   const auto edges = ctx.cfg.doc.reals("breakage.size_fraction_edges");
   struct Acc {
     int n = 0;
-    double lump_mm = 0;                // the runs' lump diameter
-    std::optional<std::size_t> cls;    // the feed class whose runs these are
+    double lump_mm = 0;              // the runs' lump diameter
+    std::optional<std::size_t> cls;  // the feed class whose runs these are
     std::vector<double> frac;
     double single = 0, largest = 0, t10 = 0;
     bool resolved = true;
