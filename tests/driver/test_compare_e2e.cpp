@@ -45,6 +45,14 @@ TEST(Compare, TwoFinishedRunsSideBySide) {
             std::string::npos)
       << v;
   // The product curves, overlaid in one embedded figure; links to both reports.
+  // The workflow run's decision on its feed's target P80, beside the sweep
+  // that has no feed.
+  const auto circuit = nlohmann::json::parse(slurp(all / "breakage/circuit.json"));
+  const std::string decision = circuit.at("decision").at("sentence").get<std::string>();
+  EXPECT_NE(html.find("<td>lowest rotor speed for a product P80 &lt;= 6 mm</td><td>" + decision +
+                      "</td><td>-</td>"),
+            std::string::npos)
+      << decision;
   EXPECT_GT(fs::file_size(out / "figures/compare_passing.png"), 5000u);
   EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
   // Every link (the two reports) resolves from the page's folder.
