@@ -10,8 +10,10 @@ meets the target). This draws circuit_p80_vs_rpm.png:
 
   left   P80 and P50 of the product [mm] against rpm (a point finer than the
          finest sieve is drawn at that sieve, hollow; a speed with no steady
-         state is left out), the target P80 as a horizontal line and the
-         lowest speed that meets it as a vertical one
+         state is left out), with the 10-90 % band of the lumps' bootstrap
+         as a bar where circuit.json has one ("band"), the target P80 as a
+         horizontal line and the lowest speed that meets it as a vertical
+         one; the decision's sentence (with its kWh/t) as the title
   right  the circulating load [t per t of fresh feed] against rpm
 
 Usage: plot_circuit.py --circuit breakage/circuit.json --out breakage/plots
@@ -20,6 +22,7 @@ Usage: plot_circuit.py --circuit breakage/circuit.json --out breakage/plots
 import argparse
 import os
 import sys
+import textwrap
 
 import matplotlib
 
@@ -75,6 +78,10 @@ def main():
         ax.plot([p[0] for p in pts], [p[1] for p in pts], "-", color=colour, label=label)
         for rpm, v, resolved in pts:
             ax.plot([rpm], [v], "o", color=colour, mfc=colour if resolved else "none")
+    for e in speeds:
+        band = e.get("band", {}).get("p80_mm") if isinstance(e.get("band"), dict) else None
+        if isinstance(band, list) and len(band) == 2 and None not in band:
+            ax.plot([e["rpm"]] * 2, band, "-", color="C0", lw=4, alpha=0.35)
     decision = data.get("decision")
     if isinstance(decision, dict) and decision.get("target_p80_mm") is not None:
         ax.axhline(decision["target_p80_mm"], color="k", ls="--", lw=1,
@@ -82,7 +89,7 @@ def main():
         if decision.get("rpm") is not None:
             ax.axvline(decision["rpm"], color="C2", ls=":", lw=1.5,
                        label=f"lowest speed {decision['rpm']:.0f} rpm")
-        ax.set_title(decision.get("sentence", ""), fontsize=9)
+        ax.set_title(textwrap.fill(decision.get("sentence", ""), 70), fontsize=8)
     ax.set_xlabel("rotor speed [rpm]")
     ax.set_ylabel("closed-circuit product size [mm]")
     ax.grid(alpha=0.3)
