@@ -14,7 +14,9 @@ meets the target). This draws circuit_p80_vs_rpm.png:
          as a bar where circuit.json has one ("band"), the target P80 as a
          horizontal line and the lowest speed that meets it as a vertical
          one; the decision's sentence (with its kWh/t) as the title
-  right  the circulating load [t per t of fresh feed] against rpm
+  right  the circulating load [t per t of fresh feed] against rpm and, on a
+         second axis, the energy per tonne of fresh feed [kWh/t] where
+         circuit.json has it ("energy"), with its band
 
 Usage: plot_circuit.py --circuit breakage/circuit.json --out breakage/plots
 """
@@ -98,8 +100,20 @@ def main():
     steady = [e for e in speeds if e["steady"]]
     ax2.plot([e["rpm"] for e in steady], [e["circulating_load"] for e in steady], "o-", color="C3")
     ax2.set_xlabel("rotor speed [rpm]")
-    ax2.set_ylabel("circulating load [t per t of fresh feed]")
+    ax2.set_ylabel("circulating load [t per t of fresh feed]", color="C3")
     ax2.grid(alpha=0.3)
+    with_energy = [e for e in steady if isinstance(e.get("energy"), dict)
+                   and e["energy"].get("specific_energy_kWh_t") is not None]
+    if with_energy:
+        ax3 = ax2.twinx()
+        ax3.plot([e["rpm"] for e in with_energy],
+                 [e["energy"]["specific_energy_kWh_t"] for e in with_energy], "s-", color="C4")
+        for e in with_energy:
+            band = e.get("band", {}).get("specific_energy_kWh_t") \
+                if isinstance(e.get("band"), dict) else None
+            if isinstance(band, list) and len(band) == 2 and None not in band:
+                ax3.plot([e["rpm"]] * 2, band, "-", color="C4", lw=4, alpha=0.35)
+        ax3.set_ylabel("energy [kWh per t of fresh feed]", color="C4")
     fig.suptitle(f"Closed circuit, feed {data.get('feed', {}).get('rate_t_h', '?')} t/h, "
                  f"cut {data.get('feed', {}).get('cut_size_mm', '?')} mm")
     fig.tight_layout()
