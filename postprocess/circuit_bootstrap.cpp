@@ -18,6 +18,22 @@ std::string IntervalText(const Interval& v, const char* format, const char* unit
          fmt::format(fmt::runtime(format), v.high) + " " + unit;
 }
 
+// A lump of class j with its pieces binned once: one piece per class it
+// reaches, at that class's representative size, holding the class's mass.
+// MeasuredBreakageColumn bins it into the same masses (to rounding), so a
+// draw costs a few entries per lump, not its every piece.
+LumpRun Binned(const SizeClasses& classes, std::size_t j, const LumpRun& lump) {
+  const std::vector<double> mass = BinPieces(classes, j, lump.pieces);
+  LumpRun out;
+  out.work = lump.work;
+  for (std::size_t i = j; i < classes.size(); ++i)
+    if (mass[i] > 0.0) {
+      out.pieces.size_mm.push_back(RepresentativeSize(classes, i));
+      out.pieces.mass_kg.push_back(mass[i]);
+    }
+  return out;
+}
+
 }  // namespace
 
 SpeedOutcome EvaluateSpeed(const CircuitSetup& setup, const SpeedLumps& speed) {
@@ -94,13 +110,17 @@ CircuitBand BootstrapCircuit(const CircuitSetup& setup, const std::vector<SpeedL
   const std::size_t n_speeds = speeds.size();
   std::vector<std::vector<double>> p80(n_speeds), kwh(n_speeds);
   std::vector<double> rpm, kwh_decided;
-  std::vector<SpeedLumps> drawn = speeds;
+  std::vector<SpeedLumps> binned = speeds;
+  for (auto& s : binned)
+    for (auto& [j, lumps] : s.by_class)
+      for (LumpRun& l : lumps) l = Binned(setup.classes, j, l);
+  std::vector<SpeedLumps> drawn = binned;
   for (int draw = 0; draw < options.draws; ++draw) {
     std::vector<SpeedOutcome> outcomes;
     std::map<double, CircuitEnergy> energy;
     for (std::size_t k = 0; k < n_speeds; ++k) {
       for (auto& [j, lumps] : drawn[k].by_class) {
-        const std::vector<LumpRun>& from = speeds[k].by_class.at(j);
+        const std::vector<LumpRun>& from = binned[k].by_class.at(j);
         for (LumpRun& l : lumps) l = from[static_cast<std::size_t>(rng() % from.size())];
       }
       outcomes.push_back(EvaluateSpeed(setup, drawn[k]));

@@ -107,7 +107,9 @@ struct CircuitBand {
 
 // The bootstrap: per draw, for each speed in order and each measured class
 // (coarsest first), as many lumps as the class has, drawn with replacement
-// (std::mt19937_64 seeded with options.seed, index = draw mod count); each
+// (std::mt19937_64 seeded with options.seed, index = draw mod count; each
+// lump's pieces binned on the classes once beforehand, which gives the same
+// columns to rounding); each
 // speed evaluated as EvaluateSpeed does, the decision as
 // DecideFromOutcomes, its kWh/t as EnergyAtDecision (with the gas when
 // every speed has it). Percentiles: linear
