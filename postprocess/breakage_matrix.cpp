@@ -121,6 +121,30 @@ std::vector<double> ScaledBreakageColumn(const SizeClasses& classes, std::size_t
   return column;
 }
 
+std::size_t NearestMeasuredClass(const SizeClasses& classes, std::size_t j,
+                                 const std::vector<std::size_t>& measured) {
+  CheckClass(classes, j, "nearest measured class");
+  if (measured.empty())
+    throw PostError(fmt::format("nearest measured class to the {} class: no class is measured",
+                                classes.name(j)));
+  std::vector<std::size_t> sorted = measured;
+  std::sort(sorted.begin(), sorted.end());
+  // Coarsest first: only a strictly nearer class replaces the one found, so
+  // the coarser of two equally near wins.
+  const double lx = std::log(RepresentativeSize(classes, j));
+  std::size_t from = sorted.front();
+  double best = HUGE_VAL;
+  for (std::size_t m : sorted) {
+    CheckClass(classes, m, "nearest measured class");
+    const double dist = std::abs(std::log(RepresentativeSize(classes, m)) - lx);
+    if (dist < best - 1e-12) {
+      best = dist;
+      from = m;
+    }
+  }
+  return from;
+}
+
 AssembledMatrix AssembleBreakageMatrix(const SizeClasses& classes,
                                        const std::map<std::size_t, std::vector<double>>& measured) {
   const std::size_t n = classes.size();
@@ -147,18 +171,9 @@ AssembledMatrix AssembleBreakageMatrix(const SizeClasses& classes,
       column = it->second;
       a.origin[j] = {"measured", j};
     } else {
-      // The nearest measured class in log(size); the coarser on a tie (the
-      // map runs coarsest first and only a strictly nearer one replaces it).
-      const double lx = std::log(RepresentativeSize(classes, j));
-      std::size_t from = measured.begin()->first;
-      double best = HUGE_VAL;
-      for (const auto& [m, c] : measured) {
-        const double dist = std::abs(std::log(RepresentativeSize(classes, m)) - lx);
-        if (dist < best - 1e-12) {
-          best = dist;
-          from = m;
-        }
-      }
+      std::vector<std::size_t> have;
+      for (const auto& [m, c] : measured) have.push_back(m);
+      const std::size_t from = NearestMeasuredClass(classes, j, have);
       column = ScaledBreakageColumn(classes, from, measured.at(from), j);
       a.origin[j] = {"scaled", from};
     }

@@ -59,6 +59,15 @@ struct AssembledMatrix {
   std::vector<ColumnOrigin> origin;  // per column
 };
 
+// The measured class nearest to class j in log(representative size)
+// (RepresentativeSize), the coarser of two equally near (within 1e-12 in
+// log size); j itself when it is measured. The rule by which a class without
+// lumps borrows from a measured one: its scaled column here, its beater work
+// per kg in circuit_energy.h. Throws PostError when `measured` is empty or
+// an index is out of range.
+std::size_t NearestMeasuredClass(const SizeClasses& classes, std::size_t j,
+                                 const std::vector<std::size_t>& measured);
+
 // The whole matrix: the measured columns as given, the finest class
 // (0, ..., 0, 1), every other class scaled from the measured class nearest
 // in log(representative size) (the coarser of two equally near). Throws

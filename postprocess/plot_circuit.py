@@ -10,9 +10,13 @@ meets the target). This draws circuit_p80_vs_rpm.png:
 
   left   P80 and P50 of the product [mm] against rpm (a point finer than the
          finest sieve is drawn at that sieve, hollow; a speed with no steady
-         state is left out), the target P80 as a horizontal line and the
-         lowest speed that meets it as a vertical one
-  right  the circulating load [t per t of fresh feed] against rpm
+         state is left out), with the 10-90 % band of the lumps' bootstrap
+         as a bar where circuit.json has one ("band"), the target P80 as a
+         horizontal line and the lowest speed that meets it as a vertical
+         one; the decision's sentence (with its kWh/t) as the title
+  right  the circulating load [t per t of fresh feed] against rpm and, on a
+         second axis, the energy per tonne of fresh feed [kWh/t] where
+         circuit.json has it ("energy"), with its band
 
 Usage: plot_circuit.py --circuit breakage/circuit.json --out breakage/plots
 """
@@ -20,6 +24,7 @@ Usage: plot_circuit.py --circuit breakage/circuit.json --out breakage/plots
 import argparse
 import os
 import sys
+import textwrap
 
 import matplotlib
 
@@ -75,6 +80,10 @@ def main():
         ax.plot([p[0] for p in pts], [p[1] for p in pts], "-", color=colour, label=label)
         for rpm, v, resolved in pts:
             ax.plot([rpm], [v], "o", color=colour, mfc=colour if resolved else "none")
+    for e in speeds:
+        band = e.get("band", {}).get("p80_mm") if isinstance(e.get("band"), dict) else None
+        if isinstance(band, list) and len(band) == 2 and None not in band:
+            ax.plot([e["rpm"]] * 2, band, "-", color="C0", lw=4, alpha=0.35)
     decision = data.get("decision")
     if isinstance(decision, dict) and decision.get("target_p80_mm") is not None:
         ax.axhline(decision["target_p80_mm"], color="k", ls="--", lw=1,
@@ -82,7 +91,7 @@ def main():
         if decision.get("rpm") is not None:
             ax.axvline(decision["rpm"], color="C2", ls=":", lw=1.5,
                        label=f"lowest speed {decision['rpm']:.0f} rpm")
-        ax.set_title(decision.get("sentence", ""), fontsize=9)
+        ax.set_title(textwrap.fill(decision.get("sentence", ""), 70), fontsize=8)
     ax.set_xlabel("rotor speed [rpm]")
     ax.set_ylabel("closed-circuit product size [mm]")
     ax.grid(alpha=0.3)
@@ -91,8 +100,20 @@ def main():
     steady = [e for e in speeds if e["steady"]]
     ax2.plot([e["rpm"] for e in steady], [e["circulating_load"] for e in steady], "o-", color="C3")
     ax2.set_xlabel("rotor speed [rpm]")
-    ax2.set_ylabel("circulating load [t per t of fresh feed]")
+    ax2.set_ylabel("circulating load [t per t of fresh feed]", color="C3")
     ax2.grid(alpha=0.3)
+    with_energy = [e for e in steady if isinstance(e.get("energy"), dict)
+                   and e["energy"].get("specific_energy_kWh_t") is not None]
+    if with_energy:
+        ax3 = ax2.twinx()
+        ax3.plot([e["rpm"] for e in with_energy],
+                 [e["energy"]["specific_energy_kWh_t"] for e in with_energy], "s-", color="C4")
+        for e in with_energy:
+            band = e.get("band", {}).get("specific_energy_kWh_t") \
+                if isinstance(e.get("band"), dict) else None
+            if isinstance(band, list) and len(band) == 2 and None not in band:
+                ax3.plot([e["rpm"]] * 2, band, "-", color="C4", lw=4, alpha=0.35)
+        ax3.set_ylabel("energy [kWh per t of fresh feed]", color="C4")
     fig.suptitle(f"Closed circuit, feed {data.get('feed', {}).get('rate_t_h', '?')} t/h, "
                  f"cut {data.get('feed', {}).get('cut_size_mm', '?')} mm")
     fig.tight_layout()

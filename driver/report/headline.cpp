@@ -278,8 +278,13 @@ void circuit_json(const fs::path& run, Problems* problems, json& h) {
     for (const char* k : {"p50_mm", "p80_mm", "circulating_load", "mass_balance_residual",
                           "product_total_t_h", "problem"})
       if (e.contains(k)) x[k] = e.at(k);
-    for (const char* k : {"specific_energy_kWh_t", "ore_power_W", "gas_shaft_power_W"})
+    for (const char* k :
+         {"specific_energy_kWh_t", "ore_power_W", "gas_shaft_power_W", "passes_per_tonne"})
       if (pick(e, "energy").is_object()) x[k] = pick(e.at("energy"), k);
+    if (pick(e, "band").is_object()) {
+      x["p80_band_mm"] = pick(e.at("band"), "p80_mm");
+      x["specific_energy_band_kWh_t"] = pick(e.at("band"), "specific_energy_kWh_t");
+    }
     h["circuit"][fmt::format("rpm{:g}", d(e.at("rpm")))] = x;
   }
   // With feed.target_p80_mm: the lowest rotor speed that meets it.
@@ -288,6 +293,9 @@ void circuit_json(const fs::path& run, Problems* problems, json& h) {
     h["circuit_decision"] = {{"target_p80_mm", pick(dec, "target_p80_mm")},
                              {"kind", pick(dec, "kind")},
                              {"rpm", pick(dec, "rpm")},
+                             {"specific_energy_kWh_t", pick(dec, "specific_energy_kWh_t")},
+                             {"energy_ore_only", pick(dec, "energy_ore_only")},
+                             {"band", pick(dec, "band")},
                              {"sentence", pick(dec, "sentence")}};
 }
 
@@ -591,11 +599,14 @@ void circuit_rows(const json& h, const RowAdder& add) {
     const std::string at = ", " + rpm_words(rpm);
     if (num(pick(c, "specific_energy_kWh_t")) && num(pick(c, "ore_power_W")))
       add(5, "energy per tonne of feed" + at,
-          fmt::format("{} kWh/t ({}ore {} kW)", g3(d(c.at("specific_energy_kWh_t"))),
+          fmt::format("{} kWh/t ({}ore {} kW{})", g3(d(c.at("specific_energy_kWh_t"))),
                       num(pick(c, "gas_shaft_power_W"))
                           ? "gas shaft " + g3(d(c.at("gas_shaft_power_W")) / 1000) + " kW + "
                           : std::string("no gas flow run: "),
-                      g3(d(c.at("ore_power_W")) / 1000)));
+                      g3(d(c.at("ore_power_W")) / 1000),
+                      num(pick(c, "passes_per_tonne"))
+                          ? ", " + g3(d(c.at("passes_per_tonne"))) + " passes per tonne"
+                          : std::string()));
     if (pick(c, "steady").is_boolean() && !c.at("steady").get<bool>()) {
       add(5, "closed circuit" + at,
           "no steady state: " + (pick(c, "problem").is_string() ? c.at("problem").get<std::string>()

@@ -100,8 +100,10 @@ void write_population_balance(StageContext& ctx, const std::vector<JobSpec>& in_
         d.file()));
     return;
   }
-  write_circuit(ctx, write_breakage_matrices(ctx, in_mill, class_runs),
-                read_mill_energy(ctx, in_mill));
+  const MeasuringRuns runs = collect_measuring_runs(ctx, in_mill, class_runs);
+  std::vector<double> rpms;
+  for (const auto& [rpm, by_class] : runs) rpms.push_back(rpm);
+  write_circuit(ctx, write_breakage_matrices(ctx, runs), runs, read_gas_shaft_power(ctx, rpms));
 }
 
 }  // namespace

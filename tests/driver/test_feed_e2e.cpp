@@ -5,8 +5,10 @@
 // written by hand, one file per class as the transport writes them), then the feed's population
 // balance: both feed classes' breakage columns measured from their own
 // runs' pieces, and the closed circuit's steady product per speed
-// (circuit.json, circuit.csv) and the lowest speed that meets
-// feed.target_p80_mm, in the report's headline.
+// (circuit.json, circuit.csv), its energy per tonne weighted over the
+// classes' mill input, and the lowest speed that meets feed.target_p80_mm
+// with its kWh/t and the band of the lumps (none: one lump per class), in
+// the report's headline.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -240,8 +242,16 @@ TEST_F(Feed, DecisionOnTheTargetP80FromTheSimulatedSpeeds) {
   // The decision from the two speeds' P80 (both steady: checked above).
   const double p0 = c.at("rotor_speeds")[0].at("p80_mm").get<double>();
   const double p1 = c.at("rotor_speeds")[1].at("p80_mm").get<double>();
+  // The decision's kWh/t: the gas ran at 2000 rpm only, so the ore's alone,
+  // read at the decided speed as the rpm is.
+  const double e0 =
+      c.at("rotor_speeds")[0].at("energy").at("ore_specific_energy_kWh_t").get<double>();
+  const double e1 =
+      c.at("rotor_speeds")[1].at("energy").at("ore_specific_energy_kWh_t").get<double>();
+  double want_kwh = NAN;
   std::string want;
   if (p0 <= 6.0) {
+    want_kwh = e0;
     EXPECT_EQ(dec.at("kind"), "met_at_lowest");
     want = p1 <= 6.0 ? "met at every simulated speed: lowest simulated 2000 rpm"
                      : "met at the lowest simulated speed, 2000 rpm, but not at 2500 rpm";
@@ -249,12 +259,28 @@ TEST_F(Feed, DecisionOnTheTargetP80FromTheSimulatedSpeeds) {
     EXPECT_EQ(dec.at("kind"), "crossed");
     const double rpm = 2000 + (6.0 - p0) / (p1 - p0) * 500;
     EXPECT_NEAR(dec.at("rpm").get<double>(), rpm, 1e-9);
+    want_kwh = e0 + (rpm - 2000) / 500 * (e1 - e0);
     want = fmt::format("met from {:.0f} rpm (interpolated between 2000 and 2500 rpm)", rpm);
   } else {
     EXPECT_EQ(dec.at("kind"), "not_met");
     EXPECT_TRUE(dec.at("rpm").is_null());
     want = "not met at any simulated speed";
   }
+  EXPECT_TRUE(dec.at("energy_ore_only").get<bool>());
+  if (std::isnan(want_kwh)) {
+    EXPECT_TRUE(dec.at("specific_energy_kWh_t").is_null()) << dec.dump(2);
+  } else {
+    EXPECT_NEAR(dec.at("specific_energy_kWh_t").get<double>(), want_kwh, 1e-12 * want_kwh);
+    want += fmt::format(", at {:.3g} kWh/t (ore only: not every speed has a gas flow run)",
+                        dec.at("specific_energy_kWh_t").get<double>());
+  }
+  // One lump per class: the bootstrap gives no band, and says so.
+  want += "; 1 lump per class: no band";
+  EXPECT_FALSE(dec.at("band").at("defined").get<bool>());
+  EXPECT_EQ(dec.at("band").at("reason"), "1 lump per class: no band");
+  EXPECT_FALSE(c.at("bootstrap").at("defined").get<bool>());
+  EXPECT_EQ(c.at("bootstrap").at("draws").get<int>(), 400);
+  for (const auto& e : c.at("rotor_speeds")) EXPECT_FALSE(e.contains("band")) << e.dump(2);
   EXPECT_EQ(dec.at("sentence").get<std::string>(), want);
   EXPECT_TRUE(fs::exists(stage() / "plots/circuit_p80_vs_rpm.png"));
 
@@ -270,36 +296,79 @@ TEST_F(Feed, DecisionOnTheTargetP80FromTheSimulatedSpeeds) {
   EXPECT_NE(html.find("lowest rotor speed for a product P80 &lt;= 6 mm"), std::string::npos);
   EXPECT_NE(html.find(want), std::string::npos) << want;
   const json summary = json::parse(slurp(*dir_ / "report/summary.json"));
-  EXPECT_EQ(summary.at("headline").at("circuit_decision").at("sentence"), want);
+  const json& hd = summary.at("headline").at("circuit_decision");
+  EXPECT_EQ(hd.at("sentence"), want);
+  EXPECT_EQ(hd.at("specific_energy_kWh_t"), dec.at("specific_energy_kWh_t"));
+  EXPECT_EQ(hd.at("band").at("reason"), "1 lump per class: no band");
 }
 
-TEST_F(Feed, EnergyPerTonneAgainstItsClosedForm) {
+// The ore power: each class's steady mill input times the beater work per
+// kg of the runs that measure it (classes 0 and 1: their own runs; the
+// finer classes, without runs, take class 1's, the nearest in log size).
+TEST_F(Feed, EnergyPerTonneWeightedOverTheClassesMillInput) {
   ASSERT_EQ(status_, 0) << slurp(*dir_ / "breakage.log");
   const json c = read("circuit.json");
   for (const auto& e : c.at("rotor_speeds")) {
     const double rpm = e.at("rpm").get<double>();
-    // lump.diameter (20 mm) lies in class 1, which has runs of its own:
-    // they stand for the lump's runs (none of lump.diameter's own ran).
-    const json run =
-        json::parse(slurp(stage() / fmt::format("jobs/rpm{:g}_c1_mill_p1/in_mill.json", rpm)));
-    const double w = run.at("energy").at("work_beater_J").get<double>() /
-                     run.at("element_mass_kg").get<double>();  // J per kg
-    ASSERT_GT(w, 0.0) << run.dump(2);
-    // kWh/t = (P_gas [kW] + w [J/kg] x 20 t/h x 1000 / 3600 / 1000) / 20 t/h
-    //       = P_gas / 20 + w / 3600; the scripted gas power only at 2000 rpm.
-    const double gas_kW = rpm == 2000 ? 30.0 : 0.0;
+    std::vector<double> w;  // J per kg, classes 0 and 1
+    for (int k = 0; k < 2; ++k) {
+      const json run = json::parse(
+          slurp(stage() / fmt::format("jobs/rpm{:g}_c{}_mill_p1/in_mill.json", rpm, k)));
+      w.push_back(run.at("energy").at("work_beater_J").get<double>() /
+                  run.at("element_mass_kg").get<double>());
+      ASSERT_GT(w.back(), 0.0) << run.dump(2);
+    }
     const json& en = e.at("energy");
-    EXPECT_NEAR(en.at("specific_energy_kWh_t").get<double>(), gas_kW / 20 + w / 3600,
-                1e-12 * (gas_kW / 20 + w / 3600))
-        << en.dump(2);
-    EXPECT_NEAR(en.at("ore_power_W").get<double>(), w * 20000.0 / 3600, 1e-9 * w);
+    const auto m = e.at("mill_input_t_h").get<std::vector<double>>();  // finest first
+    ASSERT_EQ(m.size(), 8u);
+    ASSERT_EQ(en.at("classes").size(), 8u);
+    // P_ore = sum_i m_i [t/h] x 1000 / 3600 x w_i; class i is sieve index 7 - i.
+    double ore_W = 0, through = 0;
+    for (size_t k = 0; k < 8; ++k) {
+      const size_t i = 7 - k;
+      const json& cl = en.at("classes")[k];
+      EXPECT_EQ(cl.at("class").get<size_t>(), i);
+      if (i < 2) {
+        EXPECT_EQ(cl.at("work_origin"), "measured") << cl.dump();
+        EXPECT_EQ(cl.at("lumps").get<int>(), 1);
+        EXPECT_EQ(cl.at("runs"), "the class's own");
+      } else {
+        EXPECT_EQ(cl.at("work_origin"), "nearest") << cl.dump();
+      }
+      EXPECT_EQ(cl.at("work_from_class").get<size_t>(), i == 0 ? 0u : 1u) << cl.dump();
+      const double wi = w[i == 0 ? 0 : 1];
+      EXPECT_NEAR(cl.at("beater_work_J_per_kg").get<double>(), wi, 1e-12 * wi);
+      ore_W += m[k] * 1000.0 / 3600 * wi;
+      through += m[k];
+    }
+    EXPECT_NEAR(en.at("ore_power_W").get<double>(), ore_W, 1e-12 * ore_W) << en.dump(2);
+    // kWh/t = (P_gas + P_ore) [kW] / 20 t/h; the scripted gas only at 2000 rpm.
+    const double gas_kW = rpm == 2000 ? 30.0 : 0.0;
+    const double kwh = (gas_kW + ore_W / 1000) / 20;
+    EXPECT_NEAR(en.at("specific_energy_kWh_t").get<double>(), kwh, 1e-12 * kwh) << en.dump(2);
+    EXPECT_NEAR(en.at("ore_specific_energy_kWh_t").get<double>(), ore_W / 1000 / 20, 1e-12 * kwh);
     EXPECT_EQ(en.at("gas_shaft_power_W").is_null(), rpm != 2000) << en.dump(2);
+    // Every pass counted: t through the rotor per t of fresh feed.
+    EXPECT_NEAR(en.at("passes_per_tonne").get<double>(), through / 20, 1e-12 * through);
+    EXPECT_NEAR(en.at("passes_per_tonne").get<double>(), 1 + e.at("circulating_load").get<double>(),
+                1e-9);
+    EXPECT_EQ(en.at("in_mill_lumps").get<int>(), 2);
+  }
+  if (!fs::exists(*dir_ / "report/summary.json")) {
+    ASSERT_EQ(
+        orchestrate("--case " + kData + "/tiny_feed.yaml --stage report --output " + dir_->string(),
+                    *dir_ / "report.log"),
+        0)
+        << slurp(*dir_ / "report.log");
   }
   const json summary = json::parse(slurp(*dir_ / "report/summary.json"));
-  EXPECT_TRUE(
-      summary.at("headline").at("circuit").at("rpm2000").at("specific_energy_kWh_t").is_number());
-  EXPECT_NE(slurp(*dir_ / "report/index.html").find("energy per tonne of feed, 2000 rpm"),
-            std::string::npos);
+  const json& h = summary.at("headline").at("circuit").at("rpm2000");
+  EXPECT_EQ(h.at("specific_energy_kWh_t"),
+            c.at("rotor_speeds")[0].at("energy").at("specific_energy_kWh_t"));
+  EXPECT_TRUE(h.at("passes_per_tonne").is_number());
+  const std::string html = slurp(*dir_ / "report/index.html");
+  EXPECT_NE(html.find("energy per tonne of feed, 2000 rpm"), std::string::npos);
+  EXPECT_NE(html.find("passes per tonne"), std::string::npos);
 }
 
 }  // namespace

@@ -210,3 +210,39 @@ TEST(Headline, BandOfUpperBoundsReadsAsOneBound) {
             "speed swept: its value is an upper bound); all 3 meet the ore card");
 }
 }  // namespace
+
+namespace {
+
+// The closed circuit with a feed: the energy row with the passes per tonne,
+// and the decision's sentence, kWh/t and band from breakage/circuit.json.
+TEST(Headline, ClosedCircuitEnergyAndDecisionWithItsKWhPerTonne) {
+  namespace fs = std::filesystem;
+  const fs::path run =
+      fs::temp_directory_path() / ("mill_headline_circuit_" + std::to_string(getpid()));
+  fs::remove_all(run);
+  fs::create_directories(run / "breakage");
+  std::ofstream(run / "breakage/circuit.json") << R"({"sieves_mm": [2, 4, 8],
+      "rotor_speeds": [{"rpm": 2000, "steady": true, "p50_mm": 3.1, "p80_mm": 6.2, "circulating_load": 0.8,
+                        "mass_balance_residual": 1e-16, "product_total_t_h": 20,
+                        "energy": {"specific_energy_kWh_t": 2.75, "ore_power_W": 25000, "gas_shaft_power_W": 30000,
+                                   "passes_per_tonne": 1.8},
+                        "band": {"p80_mm": [5.9, 6.6], "specific_energy_kWh_t": [2.6, 2.9]}}],
+      "decision": {"target_p80_mm": 6.5, "kind": "met_at_lowest", "rpm": 2000, "specific_energy_kWh_t": 2.75,
+                   "energy_ore_only": false, "band": {"defined": false, "reason": "1 lump per class: no band"},
+                   "sentence": "met at every simulated speed: lowest simulated 2000 rpm, at 2.75 kWh/t; 1 lump per class: no band"}})";
+  const json h = mill::report::headline_json(run);
+  const json& dec = h.at("circuit_decision");
+  EXPECT_EQ(dec.at("specific_energy_kWh_t").get<double>(), 2.75);
+  EXPECT_EQ(dec.at("band").at("reason"), "1 lump per class: no band");
+  EXPECT_EQ(h.at("circuit").at("rpm2000").at("p80_band_mm"), json::parse("[5.9, 6.6]"));
+  EXPECT_EQ(h.at("circuit").at("rpm2000").at("passes_per_tonne").get<double>(), 1.8);
+  const auto rows = headline_rows(h);
+  EXPECT_EQ(value_of(rows, "lowest rotor speed for a product P80 <= 6.5 mm"),
+            "met at every simulated speed: lowest simulated 2000 rpm, at 2.75 kWh/t; 1 lump per "
+            "class: no band");
+  EXPECT_EQ(value_of(rows, "energy per tonne of feed, 2000 rpm"),
+            "2.75 kWh/t (gas shaft 30 kW + ore 25 kW, 1.8 passes per tonne)");
+  fs::remove_all(run);
+}
+
+}  // namespace

@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include <fstream>
+
 #include "config/feed_classes.h"
 #include "jobs/job_store.h"
 #include "postprocess/breakage_results.h"
@@ -15,15 +17,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// What the runs of one class at one rotor speed gave.
-struct ClassRuns {
-  std::vector<post::LumpPieces> lumps;
-  double mass_kg = 0;
-  double lump_mm = 0;  // the lumps' diameter
-  long elements = 0;   // per lump
-  bool own = false;    // the class's own runs; else those of lump.diameter
-};
-
 // The pieces of an in-mill run in mm: d/D of its impact.h5 times the lump's
 // diameter, the convention of the breakage stage's size fractions
 // (breakage/product.json: sizes are d/D x lump.diameter).
@@ -33,6 +26,23 @@ post::LumpPieces job_pieces(const fs::path& job_dir, double lump_mm) {
   out.mass_kg = p.mass_kg;
   for (double d : p.d_rel) out.size_mm.push_back(d * lump_mm);
   return out;
+}
+
+// The beater's work on an in-mill run's lump and the lump's mass
+// (in_mill.json: energy.work_beater_J, element_mass_kg).
+post::LumpWork job_work(const fs::path& job_dir) {
+  const fs::path f = job_dir / "in_mill.json";
+  try {
+    std::ifstream in(f);
+    const auto j = nlohmann::json::parse(in);
+    return {j.at("energy").at("work_beater_J").get<double>(),
+            j.at("element_mass_kg").get<double>()};
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(fmt::format(
+        "{}: {}; expected energy.work_beater_J and element_mass_kg (rerun the job: orchestrate "
+        "--stage breakage)",
+        f.string(), e.what()));
+  }
 }
 
 nlohmann::json classes_json(const post::SizeClasses& c) {
@@ -48,21 +58,22 @@ nlohmann::json classes_json(const post::SizeClasses& c) {
 
 }  // namespace
 
-std::map<double, post::AssembledMatrix> write_breakage_matrices(
-    StageContext& ctx, const std::vector<JobSpec>& in_mill,
-    const std::vector<JobSpec>& class_runs) {
+MeasuringRuns collect_measuring_runs(const StageContext& ctx, const std::vector<JobSpec>& in_mill,
+                                     const std::vector<JobSpec>& class_runs) {
   const config::Feed& feed = ctx.cfg.feed.value();
-  const post::SizeClasses classes = post::SizeClassesFromSieves(feed.sizes_mm);
-  const std::vector<config::FeedClassRuns> plan = config::plan_feed_classes(ctx.cfg.doc, feed);
   const jobs::JobStore store(ctx.stage_dir);
-  std::map<double, std::map<std::size_t, ClassRuns>> runs;
+  MeasuringRuns runs;
   const auto add = [&](const JobSpec& job, std::size_t k, bool own) {
     ClassRuns& r = runs[job.inputs.at("rpm").get<double>()][k];
     r.own = own;
     r.lump_mm = 1000 * job.inputs.at("lump.diameter").get<double>();
     r.elements = job.inputs.at("lump.n_elements").get<long>();
-    r.lumps.push_back(job_pieces(store.job_dir(job.label), r.lump_mm));
-    for (double m : r.lumps.back().mass_kg) r.mass_kg += m;
+    const fs::path dir = store.job_dir(job.label);
+    post::LumpRun lump;
+    lump.pieces = job_pieces(dir, r.lump_mm);
+    lump.work = job_work(dir);
+    r.lumps.push_back(std::move(lump));
+    for (double m : r.lumps.back().pieces.mass_kg) r.mass_kg += m;
   };
   for (const auto& job : class_runs) add(job, in_mill_class(job).value(), true);
   // lump.diameter's runs measure its class where that class has no runs of
@@ -76,6 +87,14 @@ std::map<double, post::AssembledMatrix> write_breakage_matrices(
       add(job, lump_class, false);
     }
   }
+  return runs;
+}
+
+std::map<double, post::AssembledMatrix> write_breakage_matrices(StageContext& ctx,
+                                                                const MeasuringRuns& runs) {
+  const config::Feed& feed = ctx.cfg.feed.value();
+  const post::SizeClasses classes = post::SizeClassesFromSieves(feed.sizes_mm);
+  const std::vector<config::FeedClassRuns> plan = config::plan_feed_classes(ctx.cfg.doc, feed);
   std::map<double, post::AssembledMatrix> out;
   if (runs.empty()) return out;
   nlohmann::json speeds = nlohmann::json::array();
@@ -84,8 +103,11 @@ std::map<double, post::AssembledMatrix> write_breakage_matrices(
       "scaled_from_class\n";
   for (const auto& [rpm, by_class] : runs) {
     std::map<std::size_t, std::vector<double>> measured;
-    for (const auto& [j, r] : by_class)
-      measured[j] = post::MeasuredBreakageColumn(classes, j, r.lumps);
+    for (const auto& [j, r] : by_class) {
+      std::vector<post::LumpPieces> pieces;
+      for (const auto& l : r.lumps) pieces.push_back(l.pieces);
+      measured[j] = post::MeasuredBreakageColumn(classes, j, pieces);
+    }
     const post::AssembledMatrix a = post::AssembleBreakageMatrix(classes, measured);
     nlohmann::json columns = nlohmann::json::array();
     std::string measured_text;

@@ -8,6 +8,7 @@
 
 #include "engine/runner.h"
 #include "jobs/job_store.h"
+#include "postprocess/circuit_bootstrap.h"
 #include "postprocess/fragments.h"
 #include "progress.h"
 #include "stages/breakage/summaries.h"
@@ -21,9 +22,20 @@ std::vector<double> ascending(const std::vector<double>& coarsest_first) {
   return {coarsest_first.rbegin(), coarsest_first.rend()};
 }
 
+// [low, high] of a percentile interval; +inf (not met, no steady state) as null.
+nlohmann::json interval_json(const post::Interval& v) {
+  const auto one = [](double x) {
+    return std::isinf(x) ? nlohmann::json(nullptr) : nlohmann::json(x);
+  };
+  return nlohmann::json::array({one(v.low), one(v.high)});
+}
+
 // With feed.target_p80_mm: the lowest rotor speed whose closed-circuit P80
-// meets it (post::LowestSpeedMeetingP80) as circuit.json's "decision".
-nlohmann::json decision_json(const config::Feed& feed, const nlohmann::json& speeds) {
+// meets it (post::LowestSpeedMeetingP80) as circuit.json's "decision", with
+// its kWh/t (post::EnergyAtDecision) and the band of the lumps' bootstrap.
+nlohmann::json decision_json(const config::Feed& feed, const nlohmann::json& speeds,
+                             const std::map<double, post::CircuitEnergy>& energy, bool with_gas,
+                             const post::CircuitBand& band) {
   std::vector<post::SpeedForP80> points;
   for (const auto& e : speeds) {
     double p80 = HUGE_VAL;  // no steady state: never meets the target
@@ -32,25 +44,75 @@ nlohmann::json decision_json(const config::Feed& feed, const nlohmann::json& spe
     points.push_back({e.at("rpm").get<double>(), p80});
   }
   const post::TargetDecision d = post::LowestSpeedMeetingP80(points, *feed.target_p80_mm);
+  const post::DecisionEnergy de = post::EnergyAtDecision(d, energy, with_gas);
   using K = post::TargetDecision::Kind;
   const char* kind = d.kind == K::crossed         ? "crossed"
                      : d.kind == K::met_at_lowest ? "met_at_lowest"
                                                   : "not_met";
+  nlohmann::json b = {{"defined", band.defined}};
+  if (!band.defined) {
+    b["reason"] = band.reason;
+  } else {
+    b["rpm"] = interval_json(band.rpm);
+    b["specific_energy_kWh_t"] = band.kWh_t ? interval_json(*band.kWh_t) : nlohmann::json(nullptr);
+    b["met_draws"] = band.met_draws;
+    b["energy_draws"] = band.kWh_t_draws;
+  }
+  b["sentence"] = post::BandSentence(band);
   nlohmann::json j = {
       {"target_p80_mm", *feed.target_p80_mm},
       {"kind", kind},
       {"rpm", d.kind == K::not_met ? nlohmann::json(nullptr) : nlohmann::json(d.rpm)},
       {"met_at_every_faster_speed", d.met_above},
-      {"sentence", post::DecisionSentence(d)},
+      {"specific_energy_kWh_t", de.kWh_t ? nlohmann::json(*de.kWh_t) : nlohmann::json(nullptr)},
+      {"energy_ore_only", de.ore_only},
+      {"band", b},
+      {"sentence",
+       post::DecisionSentence(d, de.kWh_t, de.ore_only) + "; " + b["sentence"].get<std::string>()},
       {"definition",
        "the lowest rotor speed whose closed-circuit product P80 is at or below "
        "the target, interpolated linearly in rpm between the two simulated "
        "speeds where P80 crosses it; a P80 finer than the finest sieve counts as "
-       "that sieve, a speed with no steady state as not met"}};
+       "that sieve, a speed with no steady state as not met. specific_energy_kWh_t: the "
+       "speeds' energy.specific_energy_kWh_t interpolated with the same weights (the "
+       "speed's own when not interpolated); the ore's alone (energy_ore_only) unless every "
+       "simulated speed has a gas flow run. band: the bootstrap's percentile interval "
+       "(see bootstrap)"}};
   if (d.kind == K::crossed) {
     j["between_rpm"] = {d.below_rpm, d.above_rpm};
     j["interpolated"] = d.interpolated;
   }
+  return j;
+}
+
+// The lumps of every rotor speed for the bootstrap, with their gas power.
+std::vector<post::SpeedLumps> speed_lumps(const MeasuringRuns& runs,
+                                          const std::map<double, std::optional<double>>& gas_W) {
+  std::vector<post::SpeedLumps> out;
+  for (const auto& [rpm, by_class] : runs) {
+    post::SpeedLumps s;
+    s.rpm = rpm;
+    for (const auto& [j, r] : by_class) s.by_class[j] = r.lumps;
+    if (auto it = gas_W.find(rpm); it != gas_W.end()) s.gas_W = it->second;
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+nlohmann::json bootstrap_json(const post::CircuitBand& band) {
+  nlohmann::json j = {
+      {"draws", band.draws},
+      {"seed", band.seed},
+      {"percentiles", {band.low_percent, band.high_percent}},
+      {"defined", band.defined},
+      {"definition",
+       "a bootstrap over the in-mill lumps (Efron & Tibshirani 1993, percentile interval): per "
+       "draw, at each rotor speed, each measured class's lumps resampled with replacement "
+       "(std::mt19937_64 with the seed), the breakage matrix and the beater work per kg "
+       "rebuilt from the drawn lumps, the circuit re-solved and the decision redone; the band "
+       "is the percentiles over the draws (linear between order statistics). null: the draws "
+       "at that percentile did not meet the target or had no steady state"}};
+  if (!band.defined) j["reason"] = band.reason;
   return j;
 }
 
@@ -72,7 +134,8 @@ std::string mm_or_finer(const nlohmann::json& v, double finest) {
 }  // namespace
 
 void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatrix>& matrices,
-                   const std::map<double, MillEnergy>& energy) {
+                   const MeasuringRuns& runs,
+                   const std::map<double, std::optional<double>>& gas_W) {
   const config::Feed& feed = ctx.cfg.feed.value();
   const post::SizeClasses classes = post::SizeClassesFromSieves(feed.sizes_mm);
   const std::size_t n = classes.size();
@@ -80,21 +143,12 @@ void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatr
   std::vector<double> f(n);
   for (std::size_t i = 0; i < n; ++i) f[i] = feed.rate_tph * feed.mass_fractions[n - 1 - i];
   nlohmann::json speeds = nlohmann::json::array();
+  std::map<double, post::CircuitEnergy> energy;  // the steady speeds'
   std::string csv =
       "rpm,class,lower_mm,upper_mm,feed_t_h,mill_input_t_h,returned_t_h,product_t_h,"
       "product_passing_percent,classification_returned\n";
   for (const auto& [rpm, m] : matrices) {
     nlohmann::json e = {{"rpm", rpm}};
-    if (auto it = energy.find(rpm); it != energy.end()) {
-      e["energy"] = energy_json(it->second, feed.rate_tph);
-      ctx.progress.info(fmt::format(
-          "[breakage] energy at {:g} rpm: {:.3g} kWh/t ({}ore {:.3g} kW at {:g} t/h)", rpm,
-          e["energy"]["specific_energy_kWh_t"].get<double>(),
-          it->second.has_gas
-              ? fmt::format("gas shaft {:.3g} kW + ", it->second.gas_shaft_power_W / 1000)
-              : std::string("no flow report: "),
-          e["energy"]["ore_power_W"].get<double>() / 1000, feed.rate_tph));
-    }
     post::CircuitState s;
     try {
       s = post::SolveCircuit(classes, m.b, c, f);
@@ -124,6 +178,18 @@ void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatr
     e["p80_mm"] = pass.at("p80_mm");
     e["circulating_load"] = s.circulating_load;
     e["mass_balance_residual"] = s.mass_balance_residual;
+    const std::map<std::size_t, ClassRuns>& by_class = runs.at(rpm);
+    const std::vector<post::ClassWork> work = class_work(classes, by_class);
+    const std::optional<double> gas = gas_W.count(rpm) ? gas_W.at(rpm) : std::nullopt;
+    const post::CircuitEnergy en = post::MillEnergyPerTonne(s.mill_input, work, gas, s.feed_total);
+    energy[rpm] = en;
+    e["energy"] = circuit_energy_json(classes, en, work, s.mill_input, by_class);
+    ctx.progress.info(fmt::format(
+        "[breakage] energy at {:g} rpm: {:.3g} kWh/t of feed ({}ore {:.3g} kW over {:.3g} "
+        "passes per tonne at {:g} t/h)",
+        rpm, en.total_kWh_t,
+        gas ? fmt::format("gas shaft {:.3g} kW + ", *gas / 1000) : std::string("no flow report: "),
+        en.ore_W / 1000, en.passes_per_tonne, feed.rate_tph));
     speeds.push_back(e);
     for (std::size_t k = 0; k < n; ++k) {
       const std::size_t i = n - 1 - k;  // the class of sieve k
@@ -139,6 +205,20 @@ void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatr
         mm_or_finer(e["p50_mm"], feed.sizes_mm.front()), s.circulating_load,
         s.mass_balance_residual));
   }
+  // The band the lumps give: the bootstrap over each class's lumps.
+  const std::vector<post::SpeedLumps> lumps = speed_lumps(runs, gas_W);
+  bool with_gas = true;
+  for (const auto& sl : lumps) with_gas = with_gas && sl.gas_W.has_value();
+  const post::CircuitBand band = post::BootstrapCircuit({classes, c, f, feed.target_p80_mm}, lumps);
+  for (const post::SpeedBand& sb : band.speeds)
+    for (auto& e : speeds) {
+      if (e.at("rpm").get<double>() != sb.rpm) continue;
+      e["band"] = {
+          {"p80_mm", interval_json(sb.p80_mm)},
+          {"specific_energy_kWh_t", sb.kWh_t ? interval_json(*sb.kWh_t) : nlohmann::json(nullptr)},
+          {"steady_draws", sb.steady_draws}};
+    }
+  ctx.progress.info("[breakage] band of the lumps: " + post::BandSentence(band));
   nlohmann::json j = {
       {"feed",
        {{"sizes_mm", feed.sizes_mm},
@@ -150,6 +230,7 @@ void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatr
       {"sieves_mm", feed.sizes_mm},
       {"classification_returned", ascending(c)},
       {"rotor_speeds", speeds},
+      {"bootstrap", bootstrap_json(band)},
       {"units",
        {{"*_t_h", "t/h"},
         {"*_mm", "mm"},
@@ -157,7 +238,10 @@ void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatr
         {"circulating_load", "t returned to the rotor per t of fresh feed"},
         {"mass_balance_residual", "|product - feed| / feed, 1"},
         {"energy.*_kWh_t", "kWh per t of fresh feed"},
-        {"energy.*_W", "W"}}},
+        {"energy.*_W", "W"},
+        {"energy.classes[].beater_work_J_per_kg", "J per kg of lump"},
+        {"energy.passes_per_tonne", "t through the rotor per t of fresh feed"},
+        {"band.*", "[10th, 90th percentile] over the bootstrap's draws, in the quantity's unit"}}},
       {"definitions",
        {{"order", "every per-class list follows sieves_mm, finest first"},
         {"steady_state",
@@ -165,7 +249,7 @@ void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatr
          "from breakage/breakage_matrix.json, C the sharp cut at feed.cut_size_mm"},
         {"steady", "false when a class above the cut never breaks: no steady state (problem)"}}}};
   if (feed.target_p80_mm && !speeds.empty()) {
-    j["decision"] = decision_json(feed, speeds);
+    j["decision"] = decision_json(feed, speeds, energy, with_gas, band);
     ctx.progress.info(fmt::format("[breakage] product P80 <= {:g} mm in the closed circuit: {}",
                                   *feed.target_p80_mm,
                                   j["decision"]["sentence"].get<std::string>()));

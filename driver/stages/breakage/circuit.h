@@ -9,6 +9,7 @@
 #include <map>
 
 #include "postprocess/breakage_matrix.h"
+#include "stages/breakage/breakage_matrix.h"
 #include "stages/breakage/mill_energy.h"
 #include "stages/stage.h"
 
@@ -19,10 +20,13 @@ namespace mill::breakage {
 inline constexpr double kCircuitResidualLimit = 1e-9;
 
 // breakage/circuit.json and circuit.csv from the matrices per rotor speed,
-// with each speed's energy per tonne (mill_energy.h) where `energy` has it.
-// A speed at which a class above the cut never breaks has no steady state:
-// its entry says why (steady: false) and the others go on.
+// with each steady speed's energy per tonne (mill_energy.h: the runs'
+// beater work, `gas_W` the gas shaft power per speed), the decision on
+// feed.target_p80_mm with its kWh/t, and the band of a bootstrap over the
+// runs' lumps (post::BootstrapCircuit). A speed at which a class above the
+// cut never breaks has no steady state: its entry says why (steady: false)
+// and the others go on.
 void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatrix>& matrices,
-                   const std::map<double, MillEnergy>& energy);
+                   const MeasuringRuns& runs, const std::map<double, std::optional<double>>& gas_W);
 
 }  // namespace mill::breakage
