@@ -138,8 +138,7 @@ void FixStepAdaptive::reschedule_dumps() {
   for (int i = 0; i < output->ndump; ++i) {
     if (output->every_dump[i] != 0 || output->next_dump[i] <= now) continue;
     modify->clearstep_compute();
-    const bigint next =
-        static_cast<bigint>(input->variable->compute_equal(output->ivar_dump[i]));
+    const bigint next = static_cast<bigint>(input->variable->compute_equal(output->ivar_dump[i]));
     if (next <= now)
       error->all(FLERR, (std::string("fix step/adaptive: dump ") + output->dump[i]->id +
                          ": its frequency variable " + output->var_dump[i] +

@@ -328,7 +328,7 @@ void check_high_speed_impact(const std::string &bonds, const std::string &tag, d
       worst_late = std::max(worst_late, late / dt);
       EXPECT_GE(late, -2e-6 * interval) << "snapshot " << k << " at step " << snaps[k].first;
       EXPECT_LT(late, dt + 1e-9 * interval) << "snapshot " << k << " at step " << snaps[k].first
-                                       << ": " << late << " s after k x the interval";
+                                            << ": " << late << " s after k x the interval";
     }
     std::printf("dump in simulated time: %zu snapshots every %.4g s, at most %.3f steps late\n",
                 snaps.size(), interval, worst_late);
