@@ -3,11 +3,14 @@
 --dump-instr=yes: each instruction's execution count (self cost, calls
 excluded) joined with the binary's disassembly (objdump), summed by kind.
 
-    instr_mix.py PROFILE BINARY FUNCTION_SUBSTRING [--per N]
+    instr_mix.py PROFILE BINARY FUNCTION_SUBSTRING [--per N] [--site FILE]
 
 --per N divides the counts by N (e.g. the bond evaluations). Prints the
 classes (FP arithmetic by kind, loads/stores/moves, compares and branches,
-integer and other) and the counts per source line (objdump -l).
+integer and other) and the counts per source line: the innermost line
+(objdump -l), or with --site FILE the line of FILE that the instruction
+was inlined into (its inline chain, addr2line -i), e.g. the line of
+evaluate_bond that called an inlined helper.
 """
 import re
 import subprocess
@@ -80,6 +83,21 @@ def disassemble(binary, addrs):
     return insn, src
 
 
+def call_sites(binary, addrs, site_file):
+    """address -> 'file:line' of the first frame of the inline chain in site_file."""
+    out = subprocess.run(['addr2line', '-i', '-a', '-e', binary],
+                         input=''.join(f'{a:#x}\n' for a in addrs), capture_output=True,
+                         text=True).stdout
+    sites, cur = {}, None
+    for line in out.splitlines():
+        if line.startswith('0x'):
+            cur = int(line, 16)
+            sites[cur] = '?'
+        elif cur is not None and sites[cur] == '?' and site_file in line:
+            sites[cur] = line.split(' (')[0].split('/')[-1]
+    return sites
+
+
 def kind(op, args):
     fp = {'addsd': 'fp add/sub', 'subsd': 'fp add/sub', 'mulsd': 'fp mul', 'divsd': 'fp div',
           'sqrtsd': 'fp sqrt', 'addpd': 'fp add/sub (packed)', 'subpd': 'fp add/sub (packed)',
@@ -112,6 +130,8 @@ def main():
         sys.exit(f'{prof}: no instruction counts for a function matching {fn!r} (--dump-instr=yes?)')
     # PIE: callgrind's addresses are the file's own for the main executable.
     insn, src = disassemble(binary, list(counts))
+    if '--site' in sys.argv:
+        src = call_sites(binary, sorted(counts), sys.argv[sys.argv.index('--site') + 1])
     classes, lines = defaultdict(float), defaultdict(float)
     total = 0.0
     missing = 0
@@ -122,7 +142,7 @@ def main():
             continue
         op, args = insn[a]
         classes[kind(op, args)] += c
-        lines[src[a]] += c
+        lines[src.get(a, '?')] += c
     print(f'{fn}: {total / per:.1f} instructions per unit ({total:.0f} in all; '
           f'{missing / per:.1f} per unit not found in the disassembly)')
     for k, v in sorted(classes.items(), key=lambda kv: -kv[1]):
