@@ -99,6 +99,12 @@ def call_sites(binary, addrs, site_file):
 
 
 def kind(op, args):
+    # VEX forms (-march=x86-64-v3): vfmadd231sd etc. are fused multiply-adds
+    # (2 flops); the other v-prefixed ones are the SSE2 ones in new dress.
+    if op.startswith(('vfmadd', 'vfmsub', 'vfnmadd', 'vfnmsub')):
+        return 'fp fma (packed)' if op.endswith('pd') else 'fp fma'
+    if op.startswith('v') and not op.startswith('vzero'):
+        op = op[1:]
     fp = {'addsd': 'fp add/sub', 'subsd': 'fp add/sub', 'mulsd': 'fp mul', 'divsd': 'fp div',
           'sqrtsd': 'fp sqrt', 'addpd': 'fp add/sub (packed)', 'subpd': 'fp add/sub (packed)',
           'mulpd': 'fp mul (packed)', 'divpd': 'fp div (packed)'}
