@@ -1,11 +1,12 @@
 #!/bin/bash
 # Runs liggghts-mill under valgrind's callgrind for the impact deck only, cut
-# short to CG_STEPS_TIME seconds of simulated time in one chunk (the lump
-# builder's deck runs as it is). Use it as
+# short: t_end and the chunk (check_time) set to CG_TIME seconds of simulated
+# time (the fixed-step deck then runs two such chunks; the lump builder's
+# deck runs as it is). CG_OPTS: more valgrind options. Use it as
 #   MILL_LIGGGHTS=$PWD/bench/breakage/callgrind_wrap.sh CG_EXE=$PWD/build/bin/liggghts-mill \
 #   CG_OUT=/tmp/bond.callgrind CG_TIME=6.6e-5 CG_OPTS="--cache-sim=yes" \
 #   build/bin/orchestrate --case bench/breakage/reference_impact_4ms.yaml --stage breakage --output DIR
-# (the orchestrator then fails: the run is too short for its checks; the
+# (the job then holds a short impact's results, which do not matter; the
 # callgrind file is what counts). The command line is kept in $CG_OUT.cmd.
 case "$*" in
   *impact.in.tmpl*)
