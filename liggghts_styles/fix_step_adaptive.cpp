@@ -2,16 +2,21 @@
 // (docs/styles/fix_step_adaptive.md).
 #include "fix_step_adaptive.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include "comm.h"
+#include "dump.h"
 #include "error.h"
 #include "fix_bond_breakable.h"
 #include "force.h"
+#include "input.h"
 #include "modify.h"
+#include "output.h"
 #include "pair.h"
 #include "style_args.h"
 #include "update.h"
+#include "variable.h"
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
@@ -99,7 +104,11 @@ void FixStepAdaptive::reevaluate() {
   last_step_ = update->ntimestep;
   dt_bonds_ = bonds_->critical_step();
   const double dt = mill::step_limit::next_step(update->dt, dt_bonds_, rule_);
-  if (dt != update->dt) apply(dt);
+  if (dt != update->dt) {
+    apply(dt);
+    // Between runs the next run's output setup asks the variables again.
+    if (update->ntimestep < update->laststep) reschedule_dumps();
+  }
   if (out_) {
     fprintf(out_, BIGINT_FORMAT ",%.10g,%.10g,%.10g,%.0f\n", update->ntimestep,
             update->get_cur_time(), update->dt, dt_bonds_, bonds_->compute_vector(0));
@@ -115,6 +124,37 @@ void FixStepAdaptive::apply(double dt) {
   if (force->pair) force->pair->reset_dt();
   for (int i = 0; i < modify->nfix; i++) modify->fix[i]->reset_dt();
   changes_ += 1.0;
+}
+
+// A dump whose frequency is an equal-style variable (`dump_modify ID every
+// v_name`: the next step to write) learnt it at the old step; the decks' dump
+// in simulated time (the first step at or after the next multiple of the
+// interval) would then come early or late. Each such dump not due this step
+// is asked again, as Output::setup asks at the start of a run (a dump due
+// now is written after end_of_step and asks its variable then).
+void FixStepAdaptive::reschedule_dumps() {
+  const bigint now = update->ntimestep;
+  bool changed = false;
+  for (int i = 0; i < output->ndump; ++i) {
+    if (output->every_dump[i] != 0 || output->next_dump[i] <= now) continue;
+    modify->clearstep_compute();
+    const bigint next = static_cast<bigint>(input->variable->compute_equal(output->ivar_dump[i]));
+    if (next <= now)
+      error->all(FLERR, (std::string("fix step/adaptive: dump ") + output->dump[i]->id +
+                         ": its frequency variable " + output->var_dump[i] +
+                         " gave a step not after the current one")
+                            .c_str());
+    output->next_dump[i] = next;
+    modify->addstep_compute_all(next);
+    changed = true;
+  }
+  if (!changed) return;
+  output->next_dump_any = output->next_dump[0];
+  for (int i = 1; i < output->ndump; ++i)
+    output->next_dump_any = std::min(output->next_dump_any, output->next_dump[i]);
+  // Output::next also covers restarts and thermo (not visible here): it may
+  // only move earlier; a step it keeps that has nothing due writes nothing.
+  output->next = std::min(output->next, output->next_dump_any);
 }
 
 // Global outputs: 1 the step now [s], 2 the bonds' critical step at the last

@@ -40,6 +40,9 @@ class FixStepAdaptive : public Fix {
   // Re-evaluates the step now (collective); applies and logs a change.
   void reevaluate();
   void apply(double dt);
+  // Within a run: asks the frequency variables of the dumps that use one
+  // again (the decks' dumps in simulated time were scheduled at the old step).
+  void reschedule_dumps();
 
   std::string bonds_id_;
   FixBondBreakable *bonds_ = nullptr;

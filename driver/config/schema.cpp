@@ -366,7 +366,8 @@ std::vector<KeyDef> breakage_keys() {
               "The step grows once the lump has shattered; bench/README.md, \"Adaptive time "
               "step\", measures what it gains; false = one step for the whole run"),
           at_least(key("breakage.dump_interval", T::Real, "s", "5e-4",
-                       "VTK dump interval; 0 = no dumps"),
+                       "VTK dump interval in simulated time (with breakage.adaptive_step the "
+                       "dumps stay at it as the step changes); 0 = no dumps"),
                    0),
           range(key("breakage.size_fraction_edges", T::RealList, "",
                     "[0, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.85, 1.0]",

@@ -3,8 +3,12 @@
 // with the adaptive step and once with the fixed one.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <vector>
 
 #include "e2e_util.h"
 
@@ -50,8 +54,9 @@ fs::path run_case(bool adaptive) {
 }
 
 // The adaptive run: the energy ledger closes within its bound (1 % of the
-// energy put in, the run's residual_bound; a row beyond it stops the run)
-// and the step grew after the lump shattered. The fixed run: no step file,
+// energy put in, the run's residual_bound; a row beyond it stops the run),
+// the step grew after the lump shattered, and the VTK dumps stayed at their
+// interval in simulated time. The fixed run: no step file,
 // and the same breakage within the spread of such a small lump.
 TEST(AdaptiveStep, LedgerClosesAndStepGrowsAfterShattering) {
   const fs::path adaptive = run_case(true), fixed = run_case(false);
@@ -92,6 +97,51 @@ TEST(AdaptiveStep, LedgerClosesAndStepGrowsAfterShattering) {
   EXPECT_GE(intact_at_growth, 0);
   EXPECT_LT(intact_at_growth, 0.5 * bonds0) << "the step grew before the lump had shattered";
   EXPECT_FALSE(fs::exists(fixed / "run/steps.csv"));
+
+  // The VTK dumps (breakage.dump_interval 1e-4 s) stay at the interval in
+  // simulated time while the step grows: snapshot k (run/post/lump_<step>.vtk)
+  // at -2e-6 I <= t - k I < the step that ended there (the deck counts a time
+  // within 1e-6 I of a multiple as on it; the step file's 10 digits),
+  // one per interval up to the end of the run. A snapshot's time is rebuilt
+  // from the step file: row r holds the step from r.step on.
+  const double interval = 1e-4;
+  auto time_of = [&](double step) {
+    double t = step * dt0;
+    for (const auto& r : rows)
+      if (r.step <= step) t = r.time + (step - r.step) * r.dt;
+    return t;
+  };
+  auto dt_before = [&](double step) {  // length of the step that ended at `step`
+    double dt = dt0;
+    for (const auto& r : rows)
+      if (r.step < step) dt = r.dt;
+    return dt;
+  };
+  std::vector<double> dump_steps;
+  for (const auto& e : fs::directory_iterator(adaptive / "run/post")) {
+    const std::string name = e.path().filename().string();
+    // lump_<step>.vtk (not custom/vtk's lump_boundingBox_<step>.vtk)
+    if (name.rfind("lump_", 0) == 0 && e.path().extension() == ".vtk" &&
+        std::isdigit(static_cast<unsigned char>(name[5])))
+      dump_steps.push_back(std::stod(name.substr(5)));
+  }
+  std::sort(dump_steps.begin(), dump_steps.end());
+  const size_t stop_at = log.find("impact: stopped at t = ");
+  ASSERT_NE(stop_at, std::string::npos) << "no 'impact: stopped at' line in the log";
+  const double t_stop = std::stod(log.substr(stop_at + 23));
+  ASSERT_GE(dump_steps.size(), 5u) << "too few VTK dumps in " << (adaptive / "run/post");
+  EXPECT_EQ(static_cast<double>(dump_steps.size()), std::floor(t_stop / interval * (1 + 1e-9)) + 1)
+      << "one dump per " << interval << " s up to t = " << t_stop << " s";
+  double worst = 0;
+  for (size_t k = 0; k < dump_steps.size(); ++k) {
+    const double late = time_of(dump_steps[k]) - k * interval, dt = dt_before(dump_steps[k]);
+    worst = std::max(worst, late / dt);
+    EXPECT_GE(late, -2e-6 * interval) << "dump " << k << " at step " << dump_steps[k];
+    EXPECT_LT(late, dt + 1e-9 * interval) << "dump " << k << " at step " << dump_steps[k] << ": "
+                                          << late << " s after " << k << " x " << interval << " s";
+  }
+  std::printf("VTK dumps: %zu, every %g s up to t = %g s, at most %.3f steps late\n",
+              dump_steps.size(), interval, t_stop, worst);
   // Both shattered the lump: at 150 m/s nearly every bond breaks.
   EXPECT_GT(ra.at("broken_bond_fraction").get<double>(), 0.9);
   EXPECT_NEAR(ra.at("broken_bond_fraction").get<double>(),

@@ -206,6 +206,16 @@ void check_high_speed_impact(const std::string &bonds, const std::string &tag, d
     << (adaptive ? "variable dtmax equal 3*${dtr}\nfix step all step/adaptive bonds bonds safety "
                    "0.1 max "
                    "${dtmax} growth 1.5 every 1000 file steps.csv\n"
+                   // A dump in simulated time, as the decks write theirs with the
+                   // adaptive step: at the first step at or after each multiple of
+                   // 700 first steps (not a multiple of the 1000 between changes).
+                   "variable dint equal 700*${dtr}\n"
+                   "variable dk equal floor(time/${dint}+1e-6)+1\n"
+                   "variable dgap equal ceil((v_dk*${dint}-time)/dt-1e-6)\n"
+                   "variable dnext equal step+v_dgap+(v_dgap<1)\n"
+                   "variable dtime atom time\n"
+                   "dump tdump all custom 1 dumps.txt id v_dtime\n"
+                   "dump_modify tdump every v_dnext first yes format \"%d %.17g\"\n"
                  : "")
     << "variable nb equal f_bonds[1]\nthermo 5000\nrun " << steps
     << "\nprint \"${nb}\" file intact.txt\n";
@@ -273,6 +283,55 @@ void check_high_speed_impact(const std::string &bonds, const std::string &tag, d
     std::printf("adaptive: %zu re-evaluations, step %.4g -> %.4g s at most\n", steps.size(), dt0,
                 dt_max);
     EXPECT_GT(dt_max, 1.2 * dt0) << "the step did not grow";
+    // The dump in simulated time: snapshot k at the first step at or after
+    // k x 700 dt0, whatever the step did in between (fix step/adaptive asks
+    // the dump's variable again when it changes the step within a run):
+    // -2e-6 I <= T_k - k I < the step that ended at T_k (a time within 1e-6 I
+    // of a multiple counts as on it),
+    // and one snapshot per interval up to the end.
+    const double interval = 700 * dt0;
+    auto step_at = [&](double step) {  // the step length of the step ending at `step`
+      double dt = dt0;
+      for (const auto &r : steps)
+        if (r[0] < step) dt = r[2];
+      return dt;
+    };
+    std::vector<std::pair<double, double>> snaps;  // step, time
+    {
+      std::ifstream in(dir + "/dumps.txt");
+      std::string line;
+      double step = -1;
+      bool want_step = false, want_atom = false;
+      while (std::getline(in, line)) {
+        if (line.rfind("ITEM: TIMESTEP", 0) == 0) {
+          want_step = true;
+        } else if (want_step) {
+          step = std::stod(line), want_step = false;
+        } else if (line.rfind("ITEM: ATOMS", 0) == 0) {
+          want_atom = true;
+        } else if (want_atom) {
+          std::istringstream ls(line);
+          double id, t;
+          ls >> id >> t;
+          snaps.emplace_back(step, t);
+          want_atom = false;
+        }
+      }
+    }
+    const double t_final = steps.empty() ? 0.0 : steps.back()[1];
+    ASSERT_GE(snaps.size(), 3u) << "dumps.txt: too few snapshots";
+    EXPECT_EQ(static_cast<double>(snaps.size()), std::floor(t_final / interval * (1 + 1e-9)) + 1)
+        << "one snapshot per interval up to t = " << t_final << " s";
+    double worst_late = 0.0;
+    for (size_t k = 0; k < snaps.size(); ++k) {
+      const double late = snaps[k].second - k * interval, dt = step_at(snaps[k].first);
+      worst_late = std::max(worst_late, late / dt);
+      EXPECT_GE(late, -2e-6 * interval) << "snapshot " << k << " at step " << snaps[k].first;
+      EXPECT_LT(late, dt + 1e-9 * interval) << "snapshot " << k << " at step " << snaps[k].first
+                                            << ": " << late << " s after k x the interval";
+    }
+    std::printf("dump in simulated time: %zu snapshots every %.4g s, at most %.3f steps late\n",
+                snaps.size(), interval, worst_late);
   }
   EXPECT_LT(worst_res, 1e-3);             // bound: residual below 0.1 % of the input
   EXPECT_LT(worst_other, 1e-9);           // no other force: round-off
