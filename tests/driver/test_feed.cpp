@@ -23,13 +23,26 @@ Document parse(const std::string& text) { return Document::parse(text, "f.yaml",
 // A case without feed.* keys has no feed, and its canonical inputs (job ids,
 // the run folder's inputs id) hold no feed key: existing runs keep their ids.
 TEST(Feed, IsOptionalAndAbsentFromTheInputsWithoutOne) {
-  for (const char* f : {"cases/default.yaml", "cases/reference.yaml"}) {
+  for (const char* f : {"cases/reference.yaml", "tests/data/tiny_breakage.yaml"}) {
     const auto c = mill::config::load_case(kProject / f, kProject);
     EXPECT_FALSE(c.feed.has_value()) << f;
     const nlohmann::json inputs = c.doc.to_json();
     for (auto it = inputs.begin(); it != inputs.end(); ++it)
       EXPECT_NE(it.key().rfind("feed.", 0), 0u) << f << ": " << it.key();
   }
+}
+
+// The default case carries a feed: three classes around its 40 mm lump, a
+// 10 mm grate and a 6 mm P80 target, and its keys are in the inputs.
+TEST(Feed, TheDefaultCaseCarriesAFeed) {
+  const auto c = mill::config::load_case(kProject / "cases/default.yaml", kProject);
+  ASSERT_TRUE(c.feed.has_value());
+  EXPECT_EQ(c.feed->sizes_mm.back(), 45.0);
+  EXPECT_NEAR(c.feed->mass_fractions.back(), 0.5, 1e-12);
+  EXPECT_EQ(c.feed->cut_size_mm, 10.0);
+  ASSERT_TRUE(c.feed->target_p80_mm.has_value());
+  EXPECT_EQ(*c.feed->target_p80_mm, 6.0);
+  EXPECT_TRUE(c.doc.to_json().contains("feed.rate_tph"));
 }
 
 // A table whose fractions miss 1 by less than 1e-6 is scaled to sum to 1.
