@@ -35,6 +35,9 @@ int count_fragments(int natoms, const std::vector<std::pair<int, int>> &bonds);
 // granular Hertz contacts (Young's modulus youngs Pa) and hard_particles.
 std::string deck_head(double half_box, double youngs = 5e9, const std::string &boundary = "f f f");
 
+// Writes an ASCII STL rectangle (two triangles) spanned by corner p0 and edges e1, e2.
+void write_rect_stl(const std::string &path, const double *p0, const double *e1, const double *e2);
+
 }  // namespace mill_test
 
 #endif

@@ -48,28 +48,6 @@ double num(const std::map<std::string, std::string> &r, const std::string &k) {
   const auto it = r.find(k);
   return it == r.end() ? NAN : std::stod(it->second);
 }
-
-// Writes a rectangle (two triangles) spanned by corner p0 and edges e1, e2.
-void write_rect_stl(const std::string &path, const double *p0, const double *e1, const double *e2) {
-  std::ofstream o(path);
-  o.precision(17);
-  double p[4][3];
-  for (int k = 0; k < 3; ++k) {
-    p[0][k] = p0[k];
-    p[1][k] = p0[k] + e1[k];
-    p[2][k] = p0[k] + e1[k] + e2[k];
-    p[3][k] = p0[k] + e2[k];
-  }
-  const int tri[2][3] = {{0, 1, 2}, {0, 2, 3}};
-  o << "solid rect\n";
-  for (const auto &t : tri) {
-    o << "facet normal 0 0 0\nouter loop\n";
-    for (int v : t) o << "vertex " << p[v][0] << " " << p[v][1] << " " << p[v][2] << "\n";
-    o << "endloop\nendfacet\n";
-  }
-  o << "endsolid rect\n";
-}
-
 }  // namespace
 
 // A sphere thrown at 10 m/s, 30 deg to a fixed plane y = 0: one record with
