@@ -803,9 +803,8 @@ TEST(EnergyLedger, BeaterWorkOnAStruckSphereIsOnePlusETimesMVSquared) {
       "beater strike: lab speed after %.5f m/s ((1 + e) V = %.5f), e seen %.4f; work_beater "
       "%.6f J vs (1 + e_seen) m V^2 %.6f J (rel. %.2e, tol 2e-3) and (1 + 0.5) m V^2 %.6f J; "
       "work_walls %.9f J vs kinetic energy %.9f J; contact took %.6f J\n",
-      speed, (1 + e) * V, e_seen, w, (1 + e_seen) * m * V * V,
-      w / ((1 + e_seen) * m * V * V) - 1.0, (1 + e) * m * V * V, l.last("work_walls_J"), ke,
-      w - l.last("work_walls_J"));
+      speed, (1 + e) * V, e_seen, w, (1 + e_seen) * m * V * V, w / ((1 + e_seen) * m * V * V) - 1.0,
+      (1 + e) * m * V * V, l.last("work_walls_J"), ke, w - l.last("work_walls_J"));
   ASSERT_GT(speed, V);  // struck
   EXPECT_NEAR(w / ((1 + e_seen) * m * V * V), 1.0, 2e-3);
   EXPECT_NEAR(w / ((1 + e) * m * V * V), 1.0, 5e-2);
