@@ -251,10 +251,10 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& all_
         if (in_mill_class(j) == lc) lump_runs.push_back(j);
     }
     write_mill_product(ctx, jobs, write_in_mill_results(ctx, lump_runs));
-    if (ctx.cfg.feed) write_population_balance(ctx, lump_runs, class_runs);
-  } else if (ctx.cfg.feed) {
-    write_population_balance(ctx, in_mill, class_runs);
   }
+  // lump.diameter's runs measure its class only where it has none of its
+  // own (collect_measuring_runs); the class runs are passed as they are.
+  if (ctx.cfg.feed) write_population_balance(ctx, in_mill, class_runs);
   ctx.progress.info(fmt::format(
       "[breakage] results: {}/summary.csv, fractions.csv, size_distributions.csv, jk_fit.json, "
       "comminution_efficiency.json, breakage.h5, plots/*.png",
