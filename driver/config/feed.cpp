@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "config/case_config.h"
+#include "config/feed_classes.h"
 #include "postprocess/breakage_matrix.h"
 #include "postprocess/population_balance.h"
 
@@ -127,6 +128,23 @@ void check_cut_and_target(const Document& d, const Feed& f) {
                      num(finest), num(t)));
 }
 
+// The fed classes' lumps go through the transport in the run of
+// injection.lump_diameter's lumps, the sizes taking turns at the inlet: each
+// size enters over m x injection.duration (m sizes), which the run must outlast.
+void check_shared_injection(const Document& d, const Feed& f) {
+  std::size_t m = 1;
+  for (const auto& c : plan_feed_classes(d, f)) m += c.transport ? 1 : 0;
+  const double duration = d.real("injection.duration"), t_limit = d.real("injection.time_limit");
+  if (m > 1 && !(t_limit > static_cast<double>(m) * duration))
+    fail(d, "injection.time_limit",
+         fmt::format("expected longer than {} x injection.duration = {} s: with the feed, {} lump "
+                     "sizes (injection.lump_diameter and {} fed classes) take turns at the inlet, "
+                     "each over {} x {} s; got {} s: raise injection.time_limit or shorten "
+                     "injection.duration",
+                     m, num(static_cast<double>(m) * duration), m, m - 1, m, num(duration),
+                     num(t_limit)));
+}
+
 }  // namespace
 
 std::optional<Feed> read_feed(const Document& d) {
@@ -151,6 +169,7 @@ std::optional<Feed> read_feed(const Document& d) {
   if (d.has(kTarget)) f.target_p80_mm = d.real(kTarget);
   check_cut_and_target(d, f);
   if (d.integer("breakage.in_mill.lumps") > 0) lump_feed_class(d, f);
+  check_shared_injection(d, f);
   return f;
 }
 

@@ -37,6 +37,8 @@ constexpr int kDeckVersion = 5;  // 5: impact/recorder writes contact ends (cont
 // One lump of the injection schedule.
 struct Lump {
   double t = 0;               // insertion time, s
+  double diameter = 0;        // m
+  std::size_t size = 0;       // index into the run's lump sizes (TransportRun::sizes)
   std::array<double, 3> x{};  // centre, m
   std::array<double, 3> v{};  // initial velocity (local gas velocity), m/s
 };
@@ -53,6 +55,7 @@ struct Lump {
 std::vector<Lump> injection_schedule(const geometry::MillGeometry& g, const post::FlowField& field,
                                      long n, double diameter, double duration,
                                      std::vector<std::string>& notes) {
+  // (diameter: the largest lump's; the spots and their spacing are its.)
   const double r = 0.5 * diameter;
   const double half = 0.5 * g.inlet_size - 1.1 * r;
   if (half < 0)
@@ -152,8 +155,7 @@ std::vector<Lump> injection_schedule(const geometry::MillGeometry& g, const post
 // The LIGGGHTS commands that insert the lumps one by one (included by the
 // deck): each lump is created as atom type 3, sized and set moving through
 // the group of type 3, then made ore (type 1), so no atom ID is assumed.
-std::string insert_commands(const std::vector<Lump>& lumps, double diameter, double density,
-                            double dt) {
+std::string insert_commands(const std::vector<Lump>& lumps, double density, double dt) {
   std::ostringstream o;
   o << "# Written by orchestrate (transport stage): one block per lump.\n";
   long long step = 0;
@@ -163,7 +165,7 @@ std::string insert_commands(const std::vector<Lump>& lumps, double diameter, dou
       << fmt::format("create_atoms 3 single {} {} {} units box\n", num(l.x[0]), num(l.x[1]),
                      num(l.x[2]))
       << "group lump_new type 3\n"
-      << fmt::format("set group lump_new diameter {} density {}\n", num(diameter), num(density))
+      << fmt::format("set group lump_new diameter {} density {}\n", num(l.diameter), num(density))
       << fmt::format("velocity lump_new set {} {} {} units box\n", num(l.v[0]), num(l.v[1]),
                      num(l.v[2]))
       << "set group lump_new type 1\n"
@@ -255,15 +257,17 @@ std::string class_label(double rpm, std::size_t k) {
   return fmt::format("{}_class{}", rpm_label(rpm), k);
 }
 
-// The feed class of a job (none for the lumps of injection.lump_diameter).
-std::optional<std::size_t> feed_class_of(const JobSpec& job) {
-  if (!job.inputs.contains("feed_class")) return std::nullopt;
-  return job.inputs.at("feed_class").get<std::size_t>();
+// The feed classes whose lumps go through a job's run.
+std::vector<std::size_t> feed_classes_of(const JobSpec& job) {
+  std::vector<std::size_t> k;
+  for (const auto& c : job.inputs.value("feed_classes", nlohmann::json::array()))
+    k.push_back(c.at("class").get<std::size_t>());
+  return k;
 }
 
-// Where a job's outputs go (transport_dir).
+// Where a job's outputs go (transport_dir): injection.lump_diameter's lumps'.
 fs::path output_dir(const StageContext& ctx, const JobSpec& job) {
-  return transport_dir(ctx.run_dir, job.inputs.at("rotor.rpm").get<double>(), feed_class_of(job));
+  return transport_dir(ctx.run_dir, job.inputs.at("rotor.rpm").get<double>());
 }
 
 }  // namespace
@@ -271,47 +275,50 @@ fs::path output_dir(const StageContext& ctx, const JobSpec& job) {
 Plan TransportStage::plan(const StageContext& ctx) const {
   Plan p;
   const auto& d = ctx.cfg.doc;
-  // With a feed: the lumps of every feed class that gets a run of its own.
-  std::vector<config::FeedClassRuns> classes;
-  if (ctx.cfg.feed) classes = config::plan_feed_classes(d, *ctx.cfg.feed);
+  // With a feed: the lumps of every feed class that gets a run of its own go
+  // through the mill in the run of injection.lump_diameter's lumps.
+  nlohmann::json classes = nlohmann::json::array();
+  std::string sizes = fmt::format("{:g} mm", d.real("injection.lump_diameter") * 1e3);
+  if (ctx.cfg.feed)
+    for (const auto& c : config::plan_feed_classes(d, *ctx.cfg.feed)) {
+      if (!c.transport) continue;
+      classes.push_back({{"class", c.cls}, {"diameter_m", c.diameter_m}});
+      sizes += fmt::format(", {:.4g} mm (feed {})", c.diameter_m * 1e3, c.name);
+    }
   for (double rpm : d.reals("rotor.rpm")) {
     nlohmann::json in =
         case_keys(d, {"mill.", "gas.", "flow.", "sample.", "injection.", "transport."});
     in["rotor.rpm"] = rpm;
     in["ore"] = config::ore_keys(ctx.cfg.ore);
     in["deck_version"] = kDeckVersion;
-    p.jobs.push_back(
-        {rpm_label(rpm), in,
-         fmt::format("{} lumps of {:g} mm through the mill at {}", d.integer("injection.n_lumps"),
-                     d.real("injection.lump_diameter") * 1e3, rpm_label(rpm))});
-    for (const auto& c : classes) {
-      if (!c.transport) continue;
-      nlohmann::json ci = in;
-      ci["injection.lump_diameter"] = c.diameter_m;
-      ci["feed_class"] = c.cls;
-      p.jobs.push_back({class_label(rpm, c.cls), ci,
-                        fmt::format("{} lumps of {:.4g} mm (feed {}) through the mill at {}",
-                                    d.integer("injection.n_lumps"), c.diameter_m * 1e3, c.name,
-                                    rpm_label(rpm))});
-    }
+    if (!classes.empty()) in["feed_classes"] = classes;
+    p.jobs.push_back({rpm_label(rpm), in,
+                      fmt::format("{} lumps {}of {} through the mill at {}",
+                                  d.integer("injection.n_lumps"), classes.empty() ? "" : "each ",
+                                  sizes, rpm_label(rpm))});
   }
   return p;
 }
 
 // transport/<label>/{impacts.csv, contact_ends.csv, transport.h5, summary.json}
-// (transport/class_<k>/<rpm label>/ for a feed class): exist and read.
+// and the same in transport/class_<k>/<rpm label>/ for each feed class of the
+// run: exist and read.
 std::string TransportStage::damaged_outputs(const StageContext& ctx, const JobSpec& job) const {
-  const fs::path out = output_dir(ctx, job);
-  if (auto r = jobs::first_problem(
-          {jobs::check_json(out / "summary.json"), jobs::check_hdf5(out / "transport.h5"),
-           jobs::check_file(out / "impacts.csv"), jobs::check_file(out / "contact_ends.csv")});
-      !r.empty())
-    return r;
-  try {
-    post::ReadImpactsCsv((out / "impacts.csv").string());
-    post::ReadContactEndsCsv((out / "contact_ends.csv").string());
-  } catch (const std::exception& e) {
-    return e.what();
+  std::vector<fs::path> dirs = {output_dir(ctx, job)};
+  const double rpm = job.inputs.at("rotor.rpm").get<double>();
+  for (std::size_t k : feed_classes_of(job)) dirs.push_back(transport_dir(ctx.run_dir, rpm, k));
+  for (const auto& out : dirs) {
+    if (auto r = jobs::first_problem(
+            {jobs::check_json(out / "summary.json"), jobs::check_hdf5(out / "transport.h5"),
+             jobs::check_file(out / "impacts.csv"), jobs::check_file(out / "contact_ends.csv")});
+        !r.empty())
+      return r;
+    try {
+      post::ReadImpactsCsv((out / "impacts.csv").string());
+      post::ReadContactEndsCsv((out / "contact_ends.csv").string());
+    } catch (const std::exception& e) {
+      return e.what();
+    }
   }
   return "";
 }
@@ -344,10 +351,17 @@ fs::path sampled_field(const StageContext& ctx, const std::string& label, double
 
 // What one transport run shares between its steps: the settings, the mill,
 // the lumps injected, and what the deck left (end.txt, wall time).
+// One lump size of a run: injection.lump_diameter's, or a feed class's.
+struct LumpSize {
+  double diameter = 0;                  // m
+  std::optional<std::size_t> feed_class;  // none for injection.lump_diameter
+};
+
 struct TransportRun {
   std::string label;
   double rpm = 0, omega = 0;         // 1/min, rad/s
-  double diameter = 0, density = 0;  // the lumps', m and kg/m^3
+  double diameter = 0, density = 0;  // the largest lump's, m; the ore's, kg/m^3
+  std::vector<LumpSize> sizes;       // the run's lump sizes (one: no feed)
   double dt = 0;                     // s
   geometry::MillGeometry g;
   fs::path field_file, work;
@@ -383,7 +397,8 @@ std::vector<std::pair<std::string, std::string>> transport_vars(const StageConte
           {"field_file", fs::absolute(r.field_file).string()},
           {"viscosity", num(d.real("gas.viscosity"))},
           {"insert_file", "insert.in"},
-          {"n_lumps", std::to_string(d.integer("injection.n_lumps"))},
+          {"n_lumps", std::to_string(r.lumps.size())},
+          {"nsizes", std::to_string(r.sizes.size())},
           {"t_limit", num(d.real("injection.time_limit"))},
           {"dt", num(dt)},
           {"skin", num(std::max(0.25 * r.diameter, 0.002))},
@@ -404,10 +419,17 @@ void run_transport_deck(StageContext& ctx, TransportRun& r) {
   const geometry::StlSet stl = geometry::write_stl_set(r.g, r.work / "stl");
   const post::FlowField field = post::read_flow_field(r.field_file);
   std::vector<std::string> notes;
-  r.lumps = injection_schedule(r.g, field, d.integer("injection.n_lumps"), r.diameter,
-                               d.real("injection.duration"), notes);
+  // The sizes take turns (lump i is of size i mod m), so each size enters over
+  // m x injection.duration at the rate of a run of one size.
+  const auto m = static_cast<long>(r.sizes.size());
+  r.lumps = injection_schedule(r.g, field, m * d.integer("injection.n_lumps"), r.diameter,
+                               static_cast<double>(m) * d.real("injection.duration"), notes);
+  for (std::size_t i = 0; i < r.lumps.size(); ++i) {
+    r.lumps[i].size = i % r.sizes.size();
+    r.lumps[i].diameter = r.sizes[r.lumps[i].size].diameter;
+  }
   for (const auto& s : notes) ctx.progress.warn(fmt::format("transport {}: {}", r.label, s));
-  jobs::atomic_write(r.work / "insert.in", insert_commands(r.lumps, r.diameter, r.density, r.dt));
+  jobs::atomic_write(r.work / "insert.in", insert_commands(r.lumps, r.density, r.dt));
   engine::DeckRun run;
   run.deck = ctx.cfg.project_dir / "liggghts_inputs" / "transport.in.tmpl";
   run.workdir = r.work;
@@ -445,6 +467,135 @@ TransportResults read_transport_results(const TransportRun& r, double sliding_th
   post::LabelImpacts(t.records, shape, sliding_threshold);
   t.st = post::ComputeTransportStats(t.records, t.insert_time, t.ends);
   return t;
+}
+
+// A run of m lump sizes: lump i (atom ID i + 1, in insertion order) is of
+// size i mod m and the (i / m + 1)-th lump of its size.
+struct SizeOfId {
+  std::size_t m = 1;
+  long long n = 0;  // lumps in the run
+  std::size_t size(long long id) const { return static_cast<std::size_t>((id - 1) % static_cast<long long>(m)); }
+  long long local(long long id) const { return (id - 1) / static_cast<long long>(m) + 1; }
+  void check(long long id, const std::string& what) const {
+    if (id < 1 || id > n)
+      throw std::runtime_error(fmt::format(
+          "{}: particle id {} is not one of the run's {} lumps (IDs 1..{} in insertion order)",
+          what, id, n, n));
+  }
+};
+
+// The lumps of size s of a run of several: its records, contact ends and
+// trajectories with their IDs renumbered 1..n_s in insertion order, and
+// their statistics.
+TransportResults results_of_size(const TransportResults& all, const SizeOfId& ids,
+                                 std::size_t s) {
+  TransportResults t;
+  for (std::size_t i = s; i < all.insert_time.size(); i += ids.m)
+    t.insert_time.push_back(all.insert_time[i]);
+  for (const auto& rec : all.records) {
+    ids.check(rec.particle_id, "impacts.csv");
+    if (ids.size(rec.particle_id) != s) continue;
+    t.records.push_back(rec);
+    t.records.back().particle_id = ids.local(rec.particle_id);
+  }
+  for (const auto& e : all.ends) {
+    ids.check(e.particle_id, "contact_ends.csv");
+    if (ids.size(e.particle_id) != s) continue;
+    t.ends.push_back(e);
+    t.ends.back().particle_id = ids.local(e.particle_id);
+  }
+  const post::Trajectories& a = all.traj;
+  for (std::size_t k = 0; k < a.particle_id.size(); ++k) {
+    const long long id = a.particle_id[k];
+    ids.check(id, "traj.dump");
+    if (ids.size(id) != s) continue;
+    t.traj.time_s.push_back(a.time_s[k]);
+    t.traj.particle_id.push_back(ids.local(id));
+    t.traj.position.push_back(a.position[k]);
+    t.traj.velocity.push_back(a.velocity[k]);
+  }
+  t.st = post::ComputeTransportStats(t.records, t.insert_time, t.ends);
+  return t;
+}
+
+// The atom IDs the outlet counted (fix massflow/mesh's file: exits.txt, or
+// exits.txt.<rank> per MPI rank), one per lump that left.
+std::vector<long long> read_exit_ids(const fs::path& work) {
+  std::vector<long long> ids;
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(work)) {
+    const std::string n = e.path().filename().string();
+    if (n == "exits.txt" || n.rfind("exits.txt.", 0) == 0) files.push_back(e.path());
+  }
+  if (files.empty())
+    throw std::runtime_error(fmt::format(
+        "{}: missing: the deck wrote no list of the lumps that left (expected `fix massflow/mesh "
+        "... file ${{exits_file}}` in liggghts_inputs/transport.in.tmpl)",
+        (work / "exits.txt").string()));
+  for (const auto& f : files) {
+    std::ifstream in(f);
+    std::string line;
+    while (std::getline(in, line)) {
+      if (line.empty() || line[0] == '#') continue;
+      std::istringstream ls(line);
+      long long id = 0;
+      if (!(ls >> id))
+        throw std::runtime_error(fmt::format("{}: expected an atom id at the start of '{}'",
+                                             f.string(), line));
+      ids.push_back(id);
+    }
+  }
+  return ids;
+}
+
+// remaining.txt's "size <s> remaining <n>" lines (s = 1..m): the lumps of
+// each size left in the mill at the end.
+std::vector<long long> read_remaining(const fs::path& file, std::size_t m) {
+  std::ifstream in(file);
+  if (!in)
+    throw std::runtime_error(fmt::format(
+        "{}: missing: the deck did not count the lumps left per size (the size_loop at the end "
+        "of liggghts_inputs/transport.in.tmpl)",
+        file.string()));
+  std::vector<long long> n(m, -1);
+  std::string word1, word2;
+  std::size_t s = 0;
+  double count = 0;
+  while (in >> word1 >> s >> word2 >> count) {
+    if (word1 != "size" || word2 != "remaining" || s < 1 || s > m)
+      throw std::runtime_error(fmt::format("{}: expected 'size <1..{}> remaining <n>' lines",
+                                           file.string(), m));
+    n[s - 1] = std::llround(count);
+  }
+  for (std::size_t k = 0; k < m; ++k)
+    if (n[k] < 0)
+      throw std::runtime_error(
+          fmt::format("{}: no count for size {} of {}", file.string(), k + 1, m));
+  return n;
+}
+
+// contact_ends.csv's lines of size s, the particle_id column renumbered.
+std::string contact_ends_of_size(const fs::path& file, const SizeOfId& ids, std::size_t s) {
+  std::ifstream in(file);
+  std::string header, line, out;
+  if (!std::getline(in, header)) throw std::runtime_error(file.string() + ": empty");
+  // particle_id is the second column (docs/styles/fix_impact_recorder.md).
+  if (header.rfind("time_s,particle_id,", 0) != 0)
+    throw std::runtime_error(
+        fmt::format("{}: expected the header to start with time_s,particle_id, got '{}'",
+                    file.string(), header));
+  out = header + "\n";
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    const auto a = line.find(','), b = line.find(',', a + 1);
+    if (a == std::string::npos || b == std::string::npos)
+      throw std::runtime_error(fmt::format("{}: malformed line '{}'", file.string(), line));
+    const long long id = std::stoll(line.substr(a + 1, b - a - 1));
+    ids.check(id, file.string());
+    if (ids.size(id) != s) continue;
+    out += line.substr(0, a + 1) + std::to_string(ids.local(id)) + line.substr(b) + "\n";
+  }
+  return out;
 }
 
 // Cross-check (method.md): rim speed, and a ballistic impact speed: the lump
@@ -571,19 +722,15 @@ post::TransportMeta transport_meta(const TransportRun& r) {
 // Outputs: transport/<label>/{transport.h5, impacts.csv, contact_ends.csv,
 // plots/, summary.json}, each file complete or absent.
 void write_transport_outputs(StageContext& ctx, const TransportRun& r, const TransportResults& t,
-                             const nlohmann::json& summary, const fs::path& out) {
+                             const std::string& contact_ends_csv, const nlohmann::json& summary,
+                             const fs::path& out) {
   fs::create_directories(out);
   for (const char* f : {"summary.json", "impacts.csv", "contact_ends.csv", "transport.h5"})
     fs::remove(out / f);
   post::WriteTransportH5((out / "transport.h5").string(), t.records, t.st, t.insert_time, t.traj,
                          transport_meta(r), t.ends);
   post::WriteImpactsCsv((out / "impacts.csv").string(), t.records);
-  {
-    std::ifstream in(r.work / "contact_ends.csv");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    jobs::atomic_write(out / "contact_ends.csv", ss.str());
-  }
+  jobs::atomic_write(out / "contact_ends.csv", contact_ends_csv);
   engine::run_python(ctx.runner, ctx.cfg.project_dir / "postprocess" / "plot_transport.py",
                      {"--h5", (out / "transport.h5").string(), "--out", (out / "plots").string()},
                      out / "plots.log", "transport/" + r.label + "/plots");
@@ -629,7 +776,8 @@ void log_transport(StageContext& ctx, const TransportRun& r, const TransportResu
 }  // namespace
 
 // Runs the lumps through the mill at one rotor speed and writes the results
-// into transport/<label>/ (each file complete or absent).
+// into transport/<label>/, and with a feed each class's lumps' into
+// transport/class_<k>/<label>/ (each file complete or absent).
 void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::path& job_dir) {
   const auto& d = ctx.cfg.doc;
   TransportRun r;
@@ -640,20 +788,85 @@ void TransportStage::run_job(StageContext& ctx, const JobSpec& job, const fs::pa
   // injection.time_limit > duration and the time step: checked with the case.
   r.g = geometry::MillGeometry::from_config(d);
   r.omega = r.rpm * 2 * kPi / 60.0;
-  // injection.lump_diameter, or a feed class's representative size.
-  r.diameter = job.inputs.at("injection.lump_diameter").get<double>();
+  // injection.lump_diameter, then the feed classes' representative sizes.
+  r.sizes.push_back({job.inputs.at("injection.lump_diameter").get<double>(), std::nullopt});
+  for (const auto& c : job.inputs.value("feed_classes", nlohmann::json::array()))
+    r.sizes.push_back({c.at("diameter_m").get<double>(), c.at("class").get<std::size_t>()});
+  r.diameter = 0;
+  for (const auto& z : r.sizes) r.diameter = std::max(r.diameter, z.diameter);
   r.dt = d.real("injection.timestep");
   r.density = ctx.cfg.ore.real("density");
   r.work = job_dir / "run";
 
   run_transport_deck(ctx, r);
-  const TransportResults t = read_transport_results(r, d.real("transport.sliding_threshold"));
-  const CrossCheck x = cross_check(r, t.st.surfaces.at("flywheel"));
-  nlohmann::json summary = transport_summary(ctx, r, t, x, flow_converged);
-  if (const auto k = feed_class_of(job)) summary["feed_class"] = class_json(ctx, *k);
-  const fs::path out = output_dir(ctx, job);
-  write_transport_outputs(ctx, r, t, summary, out);
-  log_transport(ctx, r, t, x, out);
+  const double threshold = d.real("transport.sliding_threshold");
+  const TransportResults all = read_transport_results(r, threshold);
+  if (r.sizes.size() == 1) {
+    const CrossCheck x = cross_check(r, all.st.surfaces.at("flywheel"));
+    const nlohmann::json summary = transport_summary(ctx, r, all, x, flow_converged);
+    const fs::path out = output_dir(ctx, job);
+    std::ifstream in(r.work / "contact_ends.csv");
+    std::stringstream ends;
+    ends << in.rdbuf();
+    write_transport_outputs(ctx, r, all, ends.str(), summary, out);
+    log_transport(ctx, r, all, x, out);
+    return;
+  }
+
+  // Several sizes in one run: each size's lumps, outputs and statistics apart.
+  const SizeOfId ids{r.sizes.size(), static_cast<long long>(r.lumps.size())};
+  // Per size: the lumps the outlet listed (exits.txt) and those left in the
+  // mill at the end (remaining.txt); the rest were lost elsewhere.
+  std::vector<long long> exited(r.sizes.size(), 0);
+  for (long long id : read_exit_ids(r.work)) {
+    ids.check(id, (r.work / "exits.txt").string());
+    ++exited[ids.size(id)];
+  }
+  const std::vector<long long> remaining = read_remaining(r.work / "remaining.txt", r.sizes.size());
+  const long long lost = static_cast<long long>(r.lumps.size()) - std::llround(r.end[1]) -
+                         std::llround(r.end[2]);
+  if (std::accumulate(exited.begin(), exited.end(), 0LL) != std::llround(r.end[2]) ||
+      std::accumulate(remaining.begin(), remaining.end(), 0LL) != std::llround(r.end[1]))
+    throw std::runtime_error(fmt::format(
+        "{}: the lumps that left per size (exits.txt: {}) or remain (remaining.txt: {}) do not "
+        "add up to the run's counts in end.txt (exited {}, remaining {})",
+        r.work.string(), fmt::join(exited, " "), fmt::join(remaining, " "), std::llround(r.end[2]),
+        std::llround(r.end[1])));
+  nlohmann::json run_sizes = nlohmann::json::array();
+  for (const auto& z : r.sizes)
+    run_sizes.push_back({{"lump_diameter_mm", 1e3 * z.diameter},
+                         {"feed_class", z.feed_class ? nlohmann::json(*z.feed_class) : nullptr},
+                         {"n_lumps", static_cast<long long>(r.lumps.size() / r.sizes.size())}});
+  for (std::size_t s = 0; s < r.sizes.size(); ++s) {
+    TransportRun v = r;  // the run as seen by this size's lumps
+    v.diameter = r.sizes[s].diameter;
+    v.lumps.clear();
+    for (std::size_t i = s; i < r.lumps.size(); i += r.sizes.size()) v.lumps.push_back(r.lumps[i]);
+    v.end[2] = static_cast<double>(exited[s]);
+    v.end[1] = static_cast<double>(remaining[s]);
+    if (r.sizes[s].feed_class) v.label = class_label(r.rpm, *r.sizes[s].feed_class);
+    const TransportResults t = results_of_size(all, ids, s);
+    const CrossCheck x = cross_check(v, t.st.surfaces.at("flywheel"));
+    nlohmann::json summary = transport_summary(ctx, v, t, x, flow_converged);
+    summary["shared_run"] = {
+        {"job", "transport/jobs/" + r.label},
+        {"sizes", run_sizes},
+        {"n_lumps", static_cast<long long>(r.lumps.size())},
+        {"n_remaining", std::llround(r.end[1])},
+        {"n_lost_elsewhere", lost},
+        {"note",
+         "the lumps of every size went through the mill in one run, taking turns at the inlet "
+         "(lump i of size i mod m), each size over m x injection.duration; they meet one "
+         "another as fed lumps do. This file's figures are this size's lumps' (IDs renumbered "
+         "1..n in insertion order); end_time_s, drag_masked_particle_steps and wall_seconds "
+         "are the run's; n_exited and n_remaining are this size's (the outlet's list, "
+         "exits.txt, and the deck's count at the end, remaining.txt)"}};
+    if (r.sizes[s].feed_class) summary["feed_class"] = class_json(ctx, *r.sizes[s].feed_class);
+    const fs::path out = transport_dir(ctx.run_dir, r.rpm, r.sizes[s].feed_class);
+    write_transport_outputs(ctx, v, t, contact_ends_of_size(r.work / "contact_ends.csv", ids, s),
+                            summary, out);
+    log_transport(ctx, v, t, x, out);
+  }
 }
 
 namespace {
@@ -688,24 +901,26 @@ void TransportStage::finalize(StageContext& ctx, const std::vector<JobSpec>& job
   std::string csv = "rpm,class,lower_mm,upper_mm,lump_diameter_mm";
   for (const auto& k : class_stat_keys()) csv += "," + k;
   csv += "\n";
+  std::size_t class_runs = 0;
   for (const auto& job : jobs) {
-    const auto k = feed_class_of(job);
-    if (!k) continue;
-    const fs::path f = output_dir(ctx, job) / "summary.json";
-    std::ifstream in(f);
-    const auto s = nlohmann::json::parse(in);
     const double rpm = job.inputs.at("rotor.rpm").get<double>();
-    const nlohmann::json c = class_json(ctx, *k);
-    nlohmann::json e = {{"rpm", rpm}, {"summary", fs::relative(f, ctx.run_dir).string()}};
-    csv += fmt::format("{:g},{},{:g},{:g},{:.6g}", rpm, *k, c.at("lower_mm").get<double>(),
-                       c.at("upper_mm").get<double>(), c.at("lump_diameter_mm").get<double>());
-    for (const auto& key : class_stat_keys()) {
-      const nlohmann::json v = s.value(key, nlohmann::json(nullptr));
-      e[key] = v;
-      csv += "," + (v.is_number() ? fmt::format("{:.9g}", v.get<double>()) : std::string());
+    for (std::size_t k : feed_classes_of(job)) {
+      ++class_runs;
+      const fs::path f = transport_dir(ctx.run_dir, rpm, k) / "summary.json";
+      std::ifstream in(f);
+      const auto s = nlohmann::json::parse(in);
+      const nlohmann::json c = class_json(ctx, k);
+      nlohmann::json e = {{"rpm", rpm}, {"summary", fs::relative(f, ctx.run_dir).string()}};
+      csv += fmt::format("{:g},{},{:g},{:g},{:.6g}", rpm, k, c.at("lower_mm").get<double>(),
+                         c.at("upper_mm").get<double>(), c.at("lump_diameter_mm").get<double>());
+      for (const auto& key : class_stat_keys()) {
+        const nlohmann::json v = s.value(key, nlohmann::json(nullptr));
+        e[key] = v;
+        csv += "," + (v.is_number() ? fmt::format("{:.9g}", v.get<double>()) : std::string());
+      }
+      csv += "\n";
+      speeds[k].push_back(e);
     }
-    csv += "\n";
-    speeds[*k].push_back(e);
   }
   nlohmann::json classes = nlohmann::json::array();
   for (const auto& c : config::plan_feed_classes(ctx.cfg.doc, *ctx.cfg.feed)) {
@@ -722,14 +937,15 @@ void TransportStage::finalize(StageContext& ctx, const std::vector<JobSpec>& job
        {{"class", "feed.sizes_mm's classes, coarsest first (class 0), each [lower, upper)"},
         {"lump_diameter_mm",
          "the class's representative size (geometric mean of its edges), its lumps' diameter"},
-        {"rotor_speeds", "per rotor speed, the class run's summary.json figures (SI units)"}}}};
+        {"rotor_speeds",
+         "per rotor speed, the summary.json figures of the class's lumps (SI units), which went "
+         "through the mill in the run of that speed with the other sizes' lumps"}}}};
   jobs::atomic_write(ctx.stage_dir / "feed_classes.json", j.dump(2) + "\n");
   jobs::atomic_write(ctx.stage_dir / "feed_classes.csv", csv);
-  ctx.progress.info(fmt::format(
-      "[transport] feed classes: {}/feed_classes.{{json,csv}} ({} class run(s))",
-      ctx.stage_dir.string(), std::count_if(jobs.begin(), jobs.end(), [](const JobSpec& j) {
-        return feed_class_of(j).has_value();
-      })));
+  ctx.progress.info(
+      fmt::format("[transport] feed classes: {}/feed_classes.{{json,csv}} ({} class x rotor "
+                  "speed statistics)",
+                  ctx.stage_dir.string(), class_runs));
 }
 
 std::string TransportStage::damaged_merged_outputs(const StageContext& ctx,

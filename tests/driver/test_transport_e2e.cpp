@@ -188,11 +188,12 @@ TEST_F(TinyTransport, UnconvergedFlowOverrideIsRecorded) {
   EXPECT_NE(page.find("speed of the lumps leaving the beaters"), std::string::npos);
 }
 
-// With a feed, each fed class's lumps go through the mill in a run of their
-// own (its representative size, 26.6 mm here) beside the run of
-// injection.lump_diameter, and the stage gathers the classes' impact
+// With a feed, each fed class's lumps (its representative size, 26.6 mm here)
+// go through the mill in the run of injection.lump_diameter's lumps, the
+// sizes taking turns at the inlet; the stage splits the run's records by
+// size (IDs renumbered 1..n per size) and gathers the classes' impact
 // statistics in transport/feed_classes.{json,csv}.
-TEST(TinyTransportFeed, OneRunPerFedClassWithItsImpactStatistics) {
+TEST(TinyTransportFeed, FedClassesShareTheRunAndKeepTheirOwnStatistics) {
   const fs::path dir = scratch("transport_feed");
   std::ofstream(dir / "case.yaml")
       << kCase << "flow: {allow_unconverged: true}\n"
@@ -205,16 +206,69 @@ TEST(TinyTransportFeed, OneRunPerFedClassWithItsImpactStatistics) {
                              dir / "transport.log");
   ASSERT_EQ(st, 0) << slurp(dir / "transport.log");
   const fs::path t = dir / "run" / "transport";
-  EXPECT_TRUE(fs::exists(t / "rpm2000" / "impacts.csv"));
-  const fs::path c0 = t / "class_0" / "rpm2000";
-  for (const char* f : {"impacts.csv", "contact_ends.csv", "transport.h5", "summary.json"})
-    EXPECT_TRUE(fs::exists(c0 / f)) << f;
+  // One run for both sizes: 12 lumps, half of each, alternating at the inlet.
+  EXPECT_TRUE(fs::is_directory(t / "jobs" / "rpm2000"));
+  EXPECT_FALSE(fs::exists(t / "jobs" / "rpm2000_class0"));
+  const std::string insert = slurp(t / "jobs" / "rpm2000" / "run" / "insert.in");
+  std::vector<std::string> diameters;
+  for (size_t at = insert.find("diameter "); at != std::string::npos;
+       at = insert.find("diameter ", at + 1))
+    diameters.push_back(insert.substr(at + 9, insert.find(' ', at + 9) - at - 9));
+  ASSERT_EQ(diameters.size(), 12u) << insert;
+  for (size_t i = 0; i < diameters.size(); ++i)
+    EXPECT_NEAR(std::stod(diameters[i]), i % 2 ? 1e-3 * std::sqrt(22.4 * 31.5) : 0.03, 1e-9) << i;
+
+  const fs::path c0 = t / "class_0" / "rpm2000", l = t / "rpm2000";
+  for (const fs::path& o : {c0, l})
+    for (const char* f : {"impacts.csv", "contact_ends.csv", "transport.h5", "summary.json"})
+      EXPECT_TRUE(fs::exists(o / f)) << o / f;
   const auto s = nlohmann::json::parse(slurp(c0 / "summary.json"));
+  const auto sl = nlohmann::json::parse(slurp(l / "summary.json"));
   EXPECT_EQ(s.at("n_particles").get<long>(), 6);
+  EXPECT_EQ(sl.at("n_particles").get<long>(), 6);
   EXPECT_EQ(s.at("feed_class").at("class").get<int>(), 0);
+  EXPECT_FALSE(sl.contains("feed_class"));
   EXPECT_NEAR(s.at("feed_class").at("lump_diameter_mm").get<double>(), std::sqrt(22.4 * 31.5),
               1e-9);
   EXPECT_GT(s.at("n_flywheel_impacts").get<long>(), 0) << s.dump(2);
+  // Every lump of the run is counted once: exited and not exited per size
+  // add up to the run's.
+  const auto& run = s.at("shared_run");
+  EXPECT_EQ(run.at("n_lumps").get<long>(), 12);
+  ASSERT_EQ(run.at("sizes").size(), 2u);
+  ASSERT_TRUE(s.at("n_remaining").is_number()) << s.dump(2);
+  for (const auto* x : {&s, &sl})
+    EXPECT_EQ(x->at("n_exited").get<long>() + x->at("n_remaining").get<long>() +
+                  x->at("n_lost_elsewhere").get<long>(),
+              6);
+  EXPECT_EQ(s.at("n_remaining").get<long>() + sl.at("n_remaining").get<long>(),
+            run.at("n_remaining").get<long>());
+  EXPECT_EQ(s.at("n_lost_elsewhere").get<long>() + sl.at("n_lost_elsewhere").get<long>(),
+            run.at("n_lost_elsewhere").get<long>());
+  // The records split by size: IDs within 1..6 per size, and together every
+  // record of the run's own files.
+  const auto rec0 = mill::post::ReadImpactsCsv((c0 / "impacts.csv").string());
+  const auto recl = mill::post::ReadImpactsCsv((l / "impacts.csv").string());
+  const auto rec_all =
+      mill::post::ReadImpactsCsv((t / "jobs" / "rpm2000" / "run" / "impacts.csv").string());
+  EXPECT_EQ(rec0.size() + recl.size(), rec_all.size());
+  for (const auto* v : {&rec0, &recl})
+    for (const auto& r : *v) {
+      EXPECT_GE(r.particle_id, 1);
+      EXPECT_LE(r.particle_id, 6);
+    }
+  // A class record is the run's record of atom 2 k (the class's k-th lump).
+  ASSERT_FALSE(rec0.empty());
+  bool found = false;
+  for (const auto& r : rec_all)
+    if (r.particle_id == 2 * rec0.front().particle_id && r.time_s == rec0.front().time_s)
+      found = true;
+  EXPECT_TRUE(found);
+  const auto ends0 = mill::post::ReadContactEndsCsv((c0 / "contact_ends.csv").string());
+  const auto endsl = mill::post::ReadContactEndsCsv((l / "contact_ends.csv").string());
+  const auto ends_all =
+      mill::post::ReadContactEndsCsv((t / "jobs" / "rpm2000" / "run" / "contact_ends.csv").string());
+  EXPECT_EQ(ends0.size() + endsl.size(), ends_all.size());
 
   const auto j = nlohmann::json::parse(slurp(t / "feed_classes.json"));
   ASSERT_EQ(j.at("classes").size(), 3u);
@@ -232,6 +286,27 @@ TEST(TinyTransportFeed, OneRunPerFedClassWithItsImpactStatistics) {
   const std::string csv = slurp(t / "feed_classes.csv");
   EXPECT_EQ(csv.rfind("rpm,class,lower_mm,upper_mm,lump_diameter_mm,n_particles", 0), 0u) << csv;
   EXPECT_NE(csv.find("\n2000,0,22.4,31.5,26.5631,6,"), std::string::npos) << csv;
+}
+
+// With a feed the sizes take turns at the inlet, each over m x
+// injection.duration: a time limit that does not outlast that is refused,
+// naming the key and the sizes.
+TEST(TransportBadInput, SharedInjectionMustEndBeforeTheTimeLimit) {
+  const fs::path dir = scratch("transport_feed_badtime");
+  std::string text = kCase;
+  const std::string from = "time_limit: 0.2", to = "time_limit: 0.03";
+  ASSERT_NE(text.find(from), std::string::npos);
+  text.replace(text.find(from), from.size(), to);
+  std::ofstream(dir / "case.yaml")
+      << text << "feed: {sizes_mm: [16, 22.4, 31.5], mass_fractions: [0, 0, 1], rate_tph: 5, "
+                 "cut_size_mm: 16}\n";
+  const int st = orchestrate("--case " + (dir / "case.yaml").string() + " --stage transport --output " +
+                                 (dir / "run").string(),
+                             dir / "log");
+  EXPECT_NE(st, 0);
+  const std::string log = slurp(dir / "log");
+  EXPECT_NE(log.find("injection.time_limit"), std::string::npos) << log;
+  EXPECT_NE(log.find("2 x injection.duration = 0.04 s"), std::string::npos) << log;
 }
 
 // Without the sample stage's field the stage fails and names the file and the command.
