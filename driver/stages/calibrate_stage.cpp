@@ -120,6 +120,10 @@ void Calibration::run() {
                   n_, 2e3 * sp.cyl_r, 4e3 * sp.cyl_r, 2e3 * sp.disc_r, 1e3 * sp.disc_r));
   const Targets& t = fit_.targets();
   LabBench lab(ctx_, job_.label, dir_, sp, t);
+  // resources.jobs engine runs at once, shared among the calibrate.starts
+  // fits (the stage's jobs, which the pipeline runs side by side): the rest
+  // go to this fit's independent tests (docs/calibration.md, "Runs at once").
+  lab.set_lanes(ctx_.opts.jobs / std::max<int>(1, static_cast<int>(d_.integer("calibrate.starts"))));
   std::vector<Iteration>& hist = o.hist;
   std::vector<std::string>& notes = o.notes;
   BondParams p = estimate_bond_params(ore_, d_);
@@ -159,13 +163,21 @@ void Calibration::run() {
   for (int k = 1; k <= max_it_; ++k) {
     Iteration it;
     it.p = p;
-    it.ucs = lab.ucs(p, rate_,
-                     {fmt::format("it{}_ucs", k), fmt::format("iteration {}/{}: UCS", k, max_it_),
-                      (per_it * (k - 1)) / steps_total});
-    it.br = lab.brazilian(
-        p, rate_,
-        {fmt::format("it{}_brazilian", k), fmt::format("iteration {}/{}: Brazilian", k, max_it_),
-         (per_it * (k - 1) + 1) / steps_total});
+    // The UCS and the Brazilian test side by side when the job has two lanes.
+    run_concurrently(
+        {[&] {
+           it.ucs = lab.ucs(
+               p, rate_,
+               {fmt::format("it{}_ucs", k), fmt::format("iteration {}/{}: UCS", k, max_it_),
+                (per_it * (k - 1)) / steps_total});
+         },
+         [&] {
+           it.br = lab.brazilian(p, rate_,
+                                 {fmt::format("it{}_brazilian", k),
+                                  fmt::format("iteration {}/{}: Brazilian", k, max_it_),
+                                  (per_it * (k - 1) + 1) / steps_total});
+         }},
+        lab.lanes());
     if (fit_.fits_toughness())
       it.scb = lab.scb(p, rate_, scb_orientations_,
                        {fmt::format("it{}_scb", k),

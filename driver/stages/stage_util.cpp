@@ -3,7 +3,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <atomic>
+#include <exception>
 #include <stdexcept>
+#include <thread>
 
 namespace mill {
 
@@ -37,6 +41,33 @@ post::EnergyLedger read_run_ledger(const std::filesystem::path& workdir) {
         "ledger.csv`, docs/styles/fix_energy_ledger.md); log: {}",
         file.string(), (workdir / "liggghts.log").string()));
   return post::ReadEnergyLedger(file.string());
+}
+
+void run_concurrently(const std::vector<std::function<void()>>& tasks, int lanes) {
+  const std::size_t n = tasks.size();
+  const std::size_t threads = std::min<std::size_t>(n, static_cast<std::size_t>(std::max(1, lanes)));
+  if (threads <= 1) {
+    for (const auto& t : tasks) t();
+    return;
+  }
+  std::vector<std::exception_ptr> errors(n);
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};
+  auto worker = [&] {
+    for (std::size_t i = next++; i < n && !failed.load(); i = next++) {
+      try {
+        tasks[i]();
+      } catch (...) {
+        errors[i] = std::current_exception();
+        failed.store(true);
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (std::size_t t = 0; t < threads; ++t) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
 }
 
 }  // namespace mill

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -31,5 +32,12 @@ std::string impact_label(double velocity, double angle, int repeat);
 // run's log when the deck wrote none, PostError naming the file (and line)
 // when it does not parse.
 post::EnergyLedger read_run_ledger(const std::filesystem::path& workdir);
+
+// Runs independent tasks (engine runs of one job, each writing its own
+// folder) on up to `lanes` threads, in order of their index; with lanes <= 1
+// one after the other on this thread. After a task throws no further task
+// starts; once the running ones have ended, the exception of the first task
+// (by index) that threw is rethrown as it was (Interrupted stays Interrupted).
+void run_concurrently(const std::vector<std::function<void()>>& tasks, int lanes);
 
 }  // namespace mill

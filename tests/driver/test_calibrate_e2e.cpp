@@ -214,6 +214,51 @@ TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
       << slurp(*dir_ / "second.log");
 }
 
+// report.json without wall times, the run folder named "<run>".
+nlohmann::json without_times(const nlohmann::json& j, const std::string& run) {
+  if (j.is_object()) {
+    nlohmann::json o = nlohmann::json::object();
+    for (auto it = j.begin(); it != j.end(); ++it)
+      if (it.key().find("seconds") == std::string::npos) o[it.key()] = without_times(*it, run);
+    return o;
+  }
+  if (j.is_array()) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const auto& v : j) a.push_back(without_times(v, run));
+    return a;
+  }
+  if (j.is_string()) {
+    std::string s = j.get<std::string>();
+    for (auto at = s.find(run); at != std::string::npos; at = s.find(run)) s.replace(at, run.size(), "<run>");
+    return s;
+  }
+  return j;
+}
+
+// With --jobs 2 the one calibration job runs its independent lab tests two
+// at a time (the UCS beside the Brazilian test, the levers' runs, the
+// triaxial tests, the half discs): the same calibration to the last digit,
+// and the tests did overlap.
+TEST_F(TinyCalibration, TwoLanesGiveTheSameCalibrationWithTestsSideBySide) {
+  ASSERT_EQ(status_, 0) << slurp(*dir_ / "first.log");
+  const fs::path two = scratch("tiny_lanes");
+  ASSERT_EQ(orchestrate("--case " + kData + "/tiny_calibrate.yaml --stage calibrate --jobs 2 --output " +
+                            two.string(),
+                        two / "log"),
+            0)
+      << slurp(two / "log");
+  const auto a = without_times(read_json(*dir_ / "calibrate" / "report.json"), dir_->string());
+  const auto b = without_times(read_json(two / "calibrate" / "report.json"), two.string());
+  EXPECT_EQ(a, b) << "jobs 1:\n" << a.dump(1).substr(0, 3000) << "\njobs 2:\n" << b.dump(1).substr(0, 3000);
+  EXPECT_EQ(slurp(*dir_ / "calibrate" / "calibrated.yaml"), slurp(two / "calibrate" / "calibrated.yaml"));
+  // Overlap: each test of iteration 1 started (its info line) before the
+  // other ended (its log's last write).
+  const fs::path runs = two / "calibrate" / "jobs" / "calibration" / "runs";
+  const auto started = [&](const char* r, const char* f) { return fs::last_write_time(runs / r / f); };
+  EXPECT_LT(started("it1_ucs", "ucs_info.txt"), started("it1_brazilian", "liggghts.log"));
+  EXPECT_LT(started("it1_brazilian", "brazilian_info.txt"), started("it1_ucs", "liggghts.log"));
+}
+
 // A card whose calibrated.* section does not match its properties (stale
 // input_hash): the fit starts from that section. Used here to start from
 // chosen parameters.

@@ -3,8 +3,12 @@
 
 #include <fmt/format.h>
 
+#include <functional>
 #include <sstream>
 #include <stdexcept>
+
+#include "engine/runner.h"
+#include "stages/stage_util.h"
 
 #include "stages/calibrate/energy_report.h"
 
@@ -58,18 +62,28 @@ Checks run_checks(LabBench& lab, const BondParams& p, const UcsRun& ucs, double 
   Checks c;
   c.targets = targets;
   std::vector<post::StrengthPoint> points = {{0.0, ucs.r.ucs}};
+  // The triaxial tests side by side when the job has lanes for them.
+  c.triaxial.resize(pressures.size());
+  std::vector<std::function<void()>> tasks;
+  for (size_t k = 0; k < pressures.size(); ++k)
+    tasks.push_back([&, k] {
+      const std::string tag = fmt::format("triaxial_{}", k + 1);
+      try {
+        c.triaxial[k] =
+            lab.triaxial(p, rate, pressures[k],
+                         {tag, fmt::format("check: triaxial at {:.3g} MPa", pressures[k] / 1e6),
+                          done + static_cast<double>(k) * step_share});
+      } catch (const engine::Interrupted&) {
+        throw;
+      } catch (const std::exception& e) {
+        throw std::runtime_error(fmt::format("check {} (runs/{}, confinement {:.3g} MPa): {}",
+                                             tag, tag, pressures[k] / 1e6, e.what()));
+      }
+    });
+  run_concurrently(tasks, lab.lanes());
   for (size_t k = 0; k < pressures.size(); ++k) {
     const std::string tag = fmt::format("triaxial_{}", k + 1);
-    try {
-      c.triaxial.push_back(
-          lab.triaxial(p, rate, pressures[k],
-                       {tag, fmt::format("check: triaxial at {:.3g} MPa", pressures[k] / 1e6),
-                        done + static_cast<double>(k) * step_share}));
-    } catch (const std::exception& e) {
-      throw std::runtime_error(fmt::format("check {} (runs/{}, confinement {:.3g} MPa): {}", tag,
-                                           tag, pressures[k] / 1e6, e.what()));
-    }
-    const TriaxialRun& t = c.triaxial.back();
+    const TriaxialRun& t = c.triaxial[k];
     points.push_back({t.r.sigma3, t.r.sigma1});
     if (!t.peaked) c.notes.push_back(tag + ": reached its strain cap still loading");
   }

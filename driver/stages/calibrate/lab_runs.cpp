@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <regex>
 #include <utility>
 
@@ -171,9 +172,10 @@ ScbRun LabBench::scb(const BondParams& p, double rate, int orientations, const R
   if (orientations < 1)
     throw std::runtime_error(
         fmt::format("calibrate.scb_orientations: expected at least 1, got {}", orientations));
-  std::vector<ScbDisc> discs;
-  for (int k = 0; k < orientations; ++k) {
-    ScbDisc d;
+  std::vector<ScbDisc> discs(static_cast<std::size_t>(orientations));
+  std::vector<std::function<void()>> tasks;
+  for (int k = 0; k < orientations; ++k) tasks.push_back([&, k] {
+    ScbDisc& d = discs[static_cast<std::size_t>(k)];
     d.angle_deg = 180.0 * k / orientations;
     const RunStep disc_step{
         k == 0 ? step.tag : fmt::format("{}_o{}", step.tag, k),
@@ -191,8 +193,8 @@ ScbRun LabBench::scb(const BondParams& p, double rate, int orientations, const R
         d.curve, info_at(d.info, "radius", d.info_file), info_at(d.info, "thickness", d.info_file),
         info_at(d.info, "notch", d.info_file), info_at(d.info, "half_span", d.info_file));
     d.peaked = d.r.peak_index + 1 < d.curve.size();
-    discs.push_back(std::move(d));
-  }
+  });
+  run_concurrently(tasks, lanes_);
   return ScbRun::of(std::move(discs));
 }
 

@@ -126,6 +126,13 @@ class LabBench {
   // about the load axis from one to the next; tags <step.tag>, <step.tag>_o1, ...
   ScbRun scb(const BondParams& p, double rate, int orientations, const RunStep& step);
 
+  // How many lab runs the job may have going at once (the half discs of a
+  // bend test; callers run independent tests side by side with
+  // run_concurrently): resources.jobs shared among the stage's jobs.
+  // Each run writes its own folder, so the results do not depend on it.
+  int lanes() const { return lanes_; }
+  void set_lanes(int lanes) { lanes_ = lanes < 1 ? 1 : lanes; }
+
  private:
   struct Test;
   std::filesystem::path run_test(const Test& test, const BondParams& p, double rate,
@@ -139,6 +146,7 @@ class LabBench {
   std::filesystem::path dir_;
   Specimen sp_;
   Targets t_;
+  int lanes_ = 1;
 };
 
 }  // namespace mill::calibrate

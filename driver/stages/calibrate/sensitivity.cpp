@@ -5,8 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <sstream>
 #include <stdexcept>
+
+#include "engine/runner.h"
+#include "stages/stage_util.h"
 
 #include "postprocess/lab_tests.h"
 #include "stages/calibrate/energy_report.h"
@@ -276,32 +280,44 @@ std::string sensitivity_markdown(const Iteration& base, const std::vector<LeverR
 
 std::vector<LeverRun> run_sensitivity(LabBench& lab, const BondParams& p, double rate, double done,
                                       double step_share) {
-  std::vector<LeverRun> runs;
   const std::vector<Lever> levers = sensitivity_levers(p);
+  std::vector<LeverRun> runs(levers.size());
+  // Every lever's two tests are independent runs: as many at once as the
+  // job has lanes.
+  std::vector<std::function<void()>> tasks;
   for (size_t k = 0; k < levers.size(); ++k) {
     const Lever& l = levers[k];
-    const BondParams q = perturbed(p, l);
+    runs[k].lever = l;
     const std::string name = lever_name(l), tag = "sens_" + name;
     const double at = done + 2.0 * static_cast<double>(k) * step_share;
-    LeverRun run;
-    run.lever = l;
-    try {
-      run.ucs = lab.ucs(q, rate,
-                        {tag + "_ucs",
-                         fmt::format("sensitivity {}/{}: {} {}: UCS", k + 1, levers.size(), name,
-                                     step_text(l)),
-                         at});
-      run.br = lab.brazilian(q, rate,
-                             {tag + "_brazilian",
-                              fmt::format("sensitivity {}/{}: {} {}: Brazilian", k + 1,
-                                          levers.size(), name, step_text(l)),
-                              at + step_share});
-    } catch (const std::exception& e) {
-      throw std::runtime_error(
-          fmt::format("sensitivity of {} (runs/{}_*): {}", name, tag, e.what()));
-    }
-    runs.push_back(std::move(run));
+    const auto named = [name, tag](const std::function<void()>& f) {
+      return [f, name, tag] {
+        try {
+          f();
+        } catch (const engine::Interrupted&) {
+          throw;
+        } catch (const std::exception& e) {
+          throw std::runtime_error(
+              fmt::format("sensitivity of {} (runs/{}_*): {}", name, tag, e.what()));
+        }
+      };
+    };
+    tasks.push_back(named([&lab, &runs, &levers, &p, rate, k, name, tag, at] {
+      runs[k].ucs = lab.ucs(perturbed(p, levers[k]), rate,
+                            {tag + "_ucs",
+                             fmt::format("sensitivity {}/{}: {} {}: UCS", k + 1, levers.size(),
+                                         name, step_text(levers[k])),
+                             at});
+    }));
+    tasks.push_back(named([&lab, &runs, &levers, &p, rate, k, name, tag, at, step_share] {
+      runs[k].br = lab.brazilian(perturbed(p, levers[k]), rate,
+                                 {tag + "_brazilian",
+                                  fmt::format("sensitivity {}/{}: {} {}: Brazilian", k + 1,
+                                              levers.size(), name, step_text(levers[k])),
+                                  at + step_share});
+    }));
   }
+  run_concurrently(tasks, lab.lanes());
   return runs;
 }
 
