@@ -154,27 +154,10 @@ bool FixFluidDrag::gas_at(const double *x, double *u, double &rho) const {
     rho = rho_uniform_;
     return true;
   }
-  const mill::post::FlowField &f = *field_;
+  // Velocity and density with the same trilinear weights, in one pass.
   std::array<double, 3> ua{};
-  if (!f.velocity_at({x[0], x[1], x[2]}, ua)) return false;
-  // Density with the same trilinear weights as FlowField::velocity_at.
-  int idx[3];
-  double w[3];
-  for (int d = 0; d < 3; ++d) {
-    const double s = (x[d] - f.origin[d]) / f.spacing[d];
-    idx[d] = std::min(static_cast<int>(std::floor(s)), std::max(f.dims[d] - 2, 0));
-    w[d] = f.dims[d] > 1 ? s - idx[d] : 0.0;
-  }
-  double r = 0.0;
-  for (int c = 0; c < 8; ++c) {
-    const int di = c & 1, dj = (c >> 1) & 1, dk = (c >> 2) & 1;
-    const double wt = (di ? w[0] : 1 - w[0]) * (dj ? w[1] : 1 - w[1]) * (dk ? w[2] : 1 - w[2]);
-    const int i = std::min(idx[0] + di, f.dims[0] - 1), j = std::min(idx[1] + dj, f.dims[1] - 1),
-              k = std::min(idx[2] + dk, f.dims[2] - 1);
-    r += wt * f.rho[f.point(i, j, k)];
-  }
+  if (!field_->gas_at({x[0], x[1], x[2]}, ua, rho)) return false;
   for (int d = 0; d < 3; ++d) u[d] = ua[d];
-  rho = r;
   return true;
 }
 

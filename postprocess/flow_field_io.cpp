@@ -118,6 +118,17 @@ void FlowField::allocate(bool turbulence) {
 
 // Trilinear interpolation inside a cell of 8 gas points.
 bool FlowField::velocity_at(const std::array<double, 3>& x, std::array<double, 3>& u) const {
+  return interpolate<false>(x, u, nullptr);
+}
+
+bool FlowField::gas_at(const std::array<double, 3>& x, std::array<double, 3>& u,
+                       double& rho) const {
+  return interpolate<true>(x, u, &rho);
+}
+
+template <bool kWithRho>
+bool FlowField::interpolate(const std::array<double, 3>& x, std::array<double, 3>& u,
+                            double* rho) const {
   int idx[3];
   double w[3];
   for (int d = 0; d < 3; ++d) {
@@ -127,6 +138,7 @@ bool FlowField::velocity_at(const std::array<double, 3>& x, std::array<double, 3
     w[d] = dims[d] > 1 ? s - idx[d] : 0.0;
   }
   std::array<double, 3> acc{0, 0, 0};
+  double r = 0.0;
   for (int c = 0; c < 8; ++c) {
     const int di = c & 1, dj = (c >> 1) & 1, dk = (c >> 2) & 1;
     const double wt = (di ? w[0] : 1 - w[0]) * (dj ? w[1] : 1 - w[1]) * (dk ? w[2] : 1 - w[2]);
@@ -135,8 +147,10 @@ bool FlowField::velocity_at(const std::array<double, 3>& x, std::array<double, 3
     const size_t p = point(i, j, kk);
     if (wt > 0 && !mask[p]) return false;
     for (int d = 0; d < 3; ++d) acc[d] += wt * U[3 * p + d];
+    if constexpr (kWithRho) r += wt * this->rho[p];
   }
   u = acc;
+  if constexpr (kWithRho) *rho = r;
   return true;
 }
 

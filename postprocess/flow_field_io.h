@@ -46,6 +46,15 @@ struct FlowField {
   // Trilinear interpolation of U at x; false (u untouched) when x is off the
   // grid or any of the 8 surrounding points is outside the gas.
   bool velocity_at(const std::array<double, 3>& x, std::array<double, 3>& u) const;
+  // U and rho at x with the same weights in one pass (what the gas drag
+  // needs each step): the very numbers velocity_at gives for u, and rho
+  // interpolated with its weights; false (u, rho untouched) where
+  // velocity_at is false.
+  bool gas_at(const std::array<double, 3>& x, std::array<double, 3>& u, double& rho) const;
+
+ private:
+  template <bool kWithRho>
+  bool interpolate(const std::array<double, 3>& x, std::array<double, 3>& u, double* rho) const;
 };
 
 // Write the field to `file` (via a temp file renamed at the end). Throws

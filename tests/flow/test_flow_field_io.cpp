@@ -104,6 +104,30 @@ TEST(FlowFieldIo, TrilinearLookupIsExactForLinearFieldAndHonoursMask) {
   EXPECT_FALSE(f.velocity_at({-1.1, 0.6, 2.05}, u)) << "off the grid";
 }
 
+// gas_at (the drag's one-pass lookup): the same u as velocity_at to the last
+// bit, rho exact for the linear rho = 1 + x, and false (nothing written)
+// where velocity_at is false.
+TEST(FlowFieldIo, GasAtGivesVelocityAtsVelocityAndTheLinearDensity) {
+  const auto f = sample_field(false);
+  int checked = 0;
+  for (double x = -1.0; x <= 0.5; x += 0.037)
+    for (double y = 0.5; y <= 1.0; y += 0.041)
+      for (double z = 2.0; z <= 2.1; z += 0.013) {
+        std::array<double, 3> u1{}, u2{};
+        double rho = -1;
+        const bool a = f.velocity_at({x, y, z}, u1), b = f.gas_at({x, y, z}, u2, rho);
+        ASSERT_EQ(a, b) << x << " " << y << " " << z;
+        if (!a) {
+          EXPECT_EQ(rho, -1);
+          continue;
+        }
+        EXPECT_EQ(u1, u2);
+        EXPECT_NEAR(rho, 1 + x, 1e-12);
+        ++checked;
+      }
+  EXPECT_GT(checked, 100);
+}
+
 TEST(FlowFieldIo, ErrorsNameTheFileAndItem) {
   try {
     mill::post::read_flow_field(tmp_file("absent.h5"));
