@@ -68,7 +68,7 @@ TEST(RunConcurrently, TwoLanesOverlapTwoTasks) {
 
 // The exception of the first task (by index) that threw comes back with its
 // type (Interrupted must stay Interrupted: it stops the whole run), and no
-// task starts after a failure.
+// task starts once a failure is recorded.
 TEST(RunConcurrently, FirstFailureIsRethrownAsItWas) {
   std::atomic<int> started{0};
   std::vector<std::function<void()>> t = {
@@ -81,16 +81,34 @@ TEST(RunConcurrently, FirstFailureIsRethrownAsItWas) {
   for (int i = 0; i < 6; ++i) t.push_back([&] { ++started; });
   EXPECT_THROW(run_concurrently(t, 1), mill::engine::Interrupted);
   EXPECT_EQ(started.load(), 2);  // one lane: nothing after the failure
+  // Two lanes: the first task fails at once, the others take 20 ms each;
+  // the lane that took one of them finds the failure recorded after it and
+  // stops, so at most the failing task and one other ever start.
+  std::vector<std::function<void()>> slow = {[&] {
+    ++started;
+    throw mill::engine::Interrupted(15);
+  }};
+  for (int i = 0; i < 7; ++i)
+    slow.push_back([&] {
+      ++started;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    });
   started = 0;
   try {
-    run_concurrently(t, 2);
+    run_concurrently(slow, 2);
     FAIL() << "no exception";
   } catch (const mill::engine::Interrupted& e) {
     EXPECT_EQ(e.signal, 15);
   }
-  EXPECT_LE(started.load(), 4);  // at most the tasks taken before the failure was seen
+  EXPECT_LE(started.load(), 2);
+  // Both fail: the first by index comes back (the second fails later, so
+  // the first has surely run).
   std::vector<std::function<void()>> two = {[] { throw std::runtime_error("first"); },
-                                            [] { throw std::logic_error("second"); }};
+                                            [] {
+                                              std::this_thread::sleep_for(
+                                                  std::chrono::milliseconds(100));
+                                              throw std::logic_error("second");
+                                            }};
   for (int lanes : {1, 2}) {
     try {
       run_concurrently(two, lanes);
