@@ -270,14 +270,14 @@ std::vector<KeyDef> flow_keys() {
 // The ore injection and the lumps' transport (stage 1b), and the ore card.
 std::vector<KeyDef> transport_keys() {
   return {// --- ore injection (stage 1 transport) ---
-          range(key("injection.n_lumps", T::Int, "", "360", "Number of ore lumps injected (at most 1e5: a plan limit)"), 1,
+          range(key("injection.n_lumps", T::Int, "", "360", "Number of ore lumps injected (with a feed: of each lump size, injection.lump_diameter's and each fed class's; at most 1e5: a plan limit)"), 1,
                 false, 1e5, false),
           plausible(positive(key("injection.lump_diameter", T::Real, "m", "0.04", "Lump diameter")), 0.002, 0.5,
                     "a beater mill's feed", kFeedSource, kMetreSlips),
           positive(key("injection.duration", T::Real, "s", "0.2",
-                       "Lumps are inserted evenly over this time")),
+                       "Lumps are inserted evenly over this time (with a feed, the m lump sizes take turns at the inlet: each over m times this)")),
           positive(
-              key("injection.time_limit", T::Real, "s", "2.0", "Transport run stops at this time")),
+              key("injection.time_limit", T::Real, "s", "2.0", "Transport run stops at this time (with a feed, it must outlast m x injection.duration)")),
           positive(key("injection.timestep", T::Real, "s", "5e-6", "Particle time step")),
           at_least(key("injection.seed", T::Int, "", "4711", "Random seed of the insertion"), 1),
           positive(key("transport.trajectory_interval", T::Real, "s", "2e-3",
