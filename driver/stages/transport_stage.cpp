@@ -38,7 +38,6 @@ constexpr int kDeckVersion = 5;  // 5: impact/recorder writes contact ends (cont
 struct Lump {
   double t = 0;               // insertion time, s
   double diameter = 0;        // m
-  std::size_t size = 0;       // index into the run's lump sizes (TransportRun::sizes)
   std::array<double, 3> x{};  // centre, m
   std::array<double, 3> v{};  // initial velocity (local gas velocity), m/s
 };
@@ -424,10 +423,8 @@ void run_transport_deck(StageContext& ctx, TransportRun& r) {
   const auto m = static_cast<long>(r.sizes.size());
   r.lumps = injection_schedule(r.g, field, m * d.integer("injection.n_lumps"), r.diameter,
                                static_cast<double>(m) * d.real("injection.duration"), notes);
-  for (std::size_t i = 0; i < r.lumps.size(); ++i) {
-    r.lumps[i].size = i % r.sizes.size();
-    r.lumps[i].diameter = r.sizes[r.lumps[i].size].diameter;
-  }
+  for (std::size_t i = 0; i < r.lumps.size(); ++i)
+    r.lumps[i].diameter = r.sizes[i % r.sizes.size()].diameter;
   for (const auto& s : notes) ctx.progress.warn(fmt::format("transport {}: {}", r.label, s));
   jobs::atomic_write(r.work / "insert.in", insert_commands(r.lumps, r.density, r.dt));
   engine::DeckRun run;
