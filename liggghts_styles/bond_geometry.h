@@ -18,22 +18,42 @@ inline double norm3(const double *a) { return std::sqrt(dot3(a, a)); }
 
 // A 3-vector by value for the per-bond arithmetic: the compiler keeps its
 // components in registers (arrays written through pointers and read back
-// packed stalled store forwarding: 30 % of the bond loop in perf).
-struct Vec3 {
-  double x, y, z;
+// packed stalled store forwarding: 30 % of the bond loop in perf). T is
+// double, or a pack of doubles (bond_lanes.h) when several bonds are
+// evaluated side by side with the same operations in each lane.
+template <class T>
+struct V3 {
+  T x, y, z;
 };
+using Vec3 = V3<double>;
 inline Vec3 load3(const double *p) { return {p[0], p[1], p[2]}; }
 inline void store3(double *p, Vec3 v) {
   p[0] = v.x;
   p[1] = v.y;
   p[2] = v.z;
 }
-inline Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline Vec3 operator-(Vec3 a) { return {-a.x, -a.y, -a.z}; }
-inline Vec3 operator*(double s, Vec3 a) { return {s * a.x, s * a.y, s * a.z}; }
-inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline Vec3 cross(Vec3 a, Vec3 b) {
+template <class T>
+inline V3<T> operator+(V3<T> a, V3<T> b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+template <class T>
+inline V3<T> operator-(V3<T> a, V3<T> b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+template <class T>
+inline V3<T> operator-(V3<T> a) {
+  return {-a.x, -a.y, -a.z};
+}
+template <class T>
+inline V3<T> operator*(T s, V3<T> a) {
+  return {s * a.x, s * a.y, s * a.z};
+}
+template <class T>
+inline T dot(V3<T> a, V3<T> b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+template <class T>
+inline V3<T> cross(V3<T> a, V3<T> b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 
@@ -60,27 +80,30 @@ inline Vec3 cross(Vec3 a, Vec3 b) {
 // Relative motion of a bonded (or touching) pair a-b at the contact point,
 // which splits the line of centres Ra : Rb so that a rigid rotation of the
 // pair gives no relative motion there (objective shear increment).
-struct PairMotion {
-  Vec3 n;       // unit vector a -> b
-  Vec3 ra, rb;  // contact point from a and from b
-  Vec3 wa, wb;  // spins of a and b
-  Vec3 vt;      // tangential relative velocity of b's material point w.r.t. a's
-  double vn;    // normal relative velocity (> 0: separating)
-  Vec3 vrel_ab; // vb - va (centres)
+template <class T>
+struct PairMotionT {
+  V3<T> n;        // unit vector a -> b
+  V3<T> ra, rb;   // contact point from a and from b
+  V3<T> wa, wb;   // spins of a and b
+  V3<T> vt;       // tangential relative velocity of b's material point w.r.t. a's
+  T vn;           // normal relative velocity (> 0: separating)
+  V3<T> vrel_ab;  // vb - va (centres)
 };
-[[gnu::always_inline]] inline PairMotion pair_motion(Vec3 d, double len, Vec3 va, Vec3 vb, Vec3 wa,
-                                                     Vec3 wb, double ra_s, double rb_s) {
-  PairMotion m;
-  const double inv_len = 1.0 / len;
+using PairMotion = PairMotionT<double>;
+template <class T>
+[[gnu::always_inline]] inline PairMotionT<T> pair_motion(V3<T> d, T len, V3<T> va, V3<T> vb,
+                                                         V3<T> wa, V3<T> wb, T ra_s, T rb_s) {
+  PairMotionT<T> m;
+  const T inv_len = 1.0 / len;
   m.n = inv_len * d;
-  const double arm_a = len * ra_s / (ra_s + rb_s);
-  const double arm_b = len - arm_a;
+  const T arm_a = len * ra_s / (ra_s + rb_s);
+  const T arm_b = len - arm_a;
   m.ra = arm_a * m.n;
   m.rb = -arm_b * m.n;
   m.wa = wa;
   m.wb = wb;
   m.vrel_ab = vb - va;
-  const Vec3 vrel = ((vb - va) + cross(wb, m.rb)) - cross(wa, m.ra);
+  const V3<T> vrel = ((vb - va) + cross(wb, m.rb)) - cross(wa, m.ra);
   m.vn = dot(vrel, m.n);
   m.vt = vrel - m.vn * m.n;
   return m;
@@ -88,18 +111,19 @@ struct PairMotion {
 
 // The same pair without the relative velocity at the contact point (vn, vt
 // zero): what a bond needs at the end of its step when it has no dashpots.
-[[gnu::always_inline]] inline PairMotion pair_geometry(Vec3 d, double len, Vec3 va, Vec3 vb, Vec3 wa,
-                                                       Vec3 wb, double ra_s, double rb_s) {
-  PairMotion m;
-  m.n = (1.0 / len) * d;
-  const double arm_a = len * ra_s / (ra_s + rb_s);
+template <class T>
+[[gnu::always_inline]] inline PairMotionT<T> pair_geometry(V3<T> d, T len, V3<T> va, V3<T> vb,
+                                                           V3<T> wa, V3<T> wb, T ra_s, T rb_s) {
+  PairMotionT<T> m;
+  m.n = T(1.0 / len) * d;
+  const T arm_a = len * ra_s / (ra_s + rb_s);
   m.ra = arm_a * m.n;
   m.rb = -(len - arm_a) * m.n;
   m.wa = wa;
   m.wb = wb;
   m.vrel_ab = vb - va;
-  m.vn = 0.0;
-  m.vt = {0.0, 0.0, 0.0};
+  m.vn = T{};
+  m.vt = {T{}, T{}, T{}};
   return m;
 }
 

@@ -15,6 +15,7 @@
 
 #include "atom.h"
 #include "bond_geometry.h"
+#include "bond_lanes.h"
 #include "comm.h"
 #include "domain.h"
 #include "error.h"
@@ -33,6 +34,13 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kEventCols = 10;  // step time x y z mode tag_a tag_b sigma tau
 constexpr int kMaxBondsLimit = 64;
+// Intact bonds per evaluation unless `lanes` says otherwise: a pack of four
+// where this file is built for AVX (MILL_AVX), else two (SSE2).
+#if defined(__AVX__)
+constexpr int kDefaultLanes = 4;
+#else
+constexpr int kDefaultLanes = 2;
+#endif
 
 // Formats a double the way users wrote it (shortest round-trip-ish form).
 std::string fmt_num(double v) {
@@ -74,12 +82,13 @@ struct FixBondBreakable::AtomArrays {
 
 // Parses keywords, allocates per-atom storage and registers atom callbacks.
 FixBondBreakable::FixBondBreakable(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg) {
+  lanes_ = kDefaultLanes;
   parse_args(narg, arg);
 
   restart_global = 1;
   restart_peratom = 1;
   vector_flag = 1;
-  size_vector = 6;
+  size_vector = 7;
   global_freq = 1;
   extvector = 0;
   peratom_flag = 1;
@@ -121,8 +130,13 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
     if (iarg + 1 >= narg) fail("keyword '" + key + "' needs a value");
     const char *val = arg[iarg + 1];
     const bool parallel_only =
-        key == "moment_factor" || key == "broken_contact" || key == "contact_moment";
-    if (flat_joint_ && parallel_only) {
+        key == "moment_factor" || key == "broken_contact" || key == "contact_moment" ||
+        key == "lanes";
+    if (flat_joint_ && key == "lanes") {
+      fail("keyword 'lanes' packs fix bond/breakable's parallel bonds; a flat joint's " +
+           std::string("interfaces are evaluated one at a time: remove it ") +
+           "(docs/styles/fix_bond_flatjoint.md)");
+    } else if (flat_joint_ && parallel_only) {
       fail("keyword '" + key + "' is one of fix bond/breakable's parallel bonds; a flat joint " +
            "has none (its elements carry the moments, broken elements stay as frictional " +
            "contacts): remove it (docs/styles/fix_bond_flatjoint.md)");
@@ -189,6 +203,9 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
       if (!(gap_ >= 0.0)) fail("gap must be >= 0, got " + std::string(val));
     } else if (key == "max_bonds") {
       max_bonds_ = args.integer(arg[iarg], val, 1, kMaxBondsLimit);
+    } else if (key == "lanes") {
+      lanes_ = args.integer(arg[iarg], val, 1, 4);
+      if (lanes_ == 3) fail("lanes must be 1, 2 or 4 (intact bonds per evaluation), got 3");
     } else if (key == "break_log") {
       break_log_path_ = val;
     } else if (key == "dump_bonds") {
@@ -211,7 +228,7 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
                : "' (expected radius_multiplier, modulus, stiffness_ratio, "
                  "tensile_strength, cohesion, friction_angle, moment_factor, "
                  "broken_contact, contact_moment, unbonded_fraction, unbonded_seed, "
-                 "damping, gap, max_bonds, break_log, dump_bonds)"));
+                 "damping, gap, max_bonds, lanes, break_log, dump_bonds)"));
     }
     iarg += 2;
   }
@@ -585,120 +602,138 @@ void FixBondBreakable::remove_slot(int i, int k) {
   nbond_[i] = last;
 }
 
-// Evaluates the bond between atoms a (lower tag) and b in the canonical frame:
-// advances the history in bond when advance is true, then returns forces,
-// torques, stresses and the breakage verdict.
-inline void FixBondBreakable::evaluate_bond(const AtomArrays &at, ListedBond &bond, bool advance,
-                                            BondResult &out) const {
+// The law's inputs for the bond in the canonical frame (a = lower tag).
+inline void FixBondBreakable::load_bond(const AtomArrays &at, const ListedBond &bond,
+                                        mill::parallel_bond::In<double> &in) const {
   const int a = bond.a, b = bond.b;
-  const Vec3 xa = load3(at.x[a]);
-  const Vec3 d = load3(at.x[b]) - xa;
-  const double len = std::sqrt(dot(d, d));
-  // The relative motion at the end of the step is needed for the dashpots
-  // only; otherwise the geometry (n, the contact point) is enough.
-  const PairMotion m = damping_ > 0.0
-                           ? pair_motion(d, len, load3(at.v[a]), load3(at.v[b]), load3(at.omega[a]),
-                                         load3(at.omega[b]), at.radius[a], at.radius[b])
-                           : pair_geometry(d, len, load3(at.v[a]), load3(at.v[b]), load3(at.omega[a]),
-                                           load3(at.omega[b]), at.radius[a], at.radius[b]);
-  const Vec3 n = m.n;
-  const double dt = at.dt;
-  Vec3 fs = load3(bond.fs);
-  Vec3 mb = load3(bond.mb);
-  double mt = bond.mt;
+  in.xa = load3(at.x[a]);
+  in.xb = load3(at.x[b]);
+  in.va = load3(at.v[a]);
+  in.vb = load3(at.v[b]);
+  in.wa = load3(at.omega[a]);
+  in.wb = load3(at.omega[b]);
+  in.ra = at.radius[a];
+  in.rb = at.radius[b];
+  in.fs = load3(bond.fs);
+  in.mb = load3(bond.mb);
+  in.mt = bond.mt;
+  in.l0 = bond.l0;
+  in.kna = bond.kna;
+  in.ksa = bond.ksa;
+  in.kni = bond.kni;
+  in.ksj = bond.ksj;
+  in.inv_area = bond.inv_area;
+  in.inv_inertia = bond.inv_inertia;
+  in.rbond = bond.rbond;
+  in.cn = bond.cn;
+  in.cs = bond.cs;
+}
 
-  if (advance) {
-    // The step's increments at its midpoint (second order): the velocities
-    // are those of the half step, so the pair's geometry is taken at the half
-    // step too, x - v dt/2. Taken at the end of the step, the increments make
-    // a first-order error that pumps energy into a tumbling bonded pair
-    // (docs/styles/fix_bond_breakable.md, "Energy").
-    const Vec3 dmid = d - (0.5 * dt) * (m.vrel_ab);
-    const double lmid = std::sqrt(dot(dmid, dmid));
-    const PairMotion h = pair_motion(dmid, lmid, load3(at.v[a]), load3(at.v[b]), m.wa, m.wb,
-                                     at.radius[a], at.radius[b]);
-    // Carry the stored shear force and bending moment with the bond plane,
-    // onto the midpoint plane, then (after the increment) onto the end plane.
-    // The spin about n: half with each move (applied once, at the end, a
-    // twisting pair gains 14 % of its energy in 11 turns).
-    const double spin = 0.5 * (dot(m.wa, n) + dot(m.wb, n)) * dt;
-    fs = rotate_onto_plane(fs, h.n, 0.5 * spin);
-    mb = rotate_onto_plane(mb, h.n, 0.5 * spin);
-    // Potyondy & Cundall 2004, eq. 6: incremental shear force and moments.
-    const Vec3 wrel = m.wb - m.wa;
-    const double wn = dot(wrel, h.n);
-    const double ksa_dt = bond.ksa * dt, kni_dt = bond.kni * dt;
-    fs = fs - ksa_dt * h.vt;                  // dF^s = -k^s A dU^s
-    mb = mb - kni_dt * (wrel - wn * h.n);     // dM^s = -k^n I dtheta^s
-    mt -= bond.ksj * wn * dt;                 // dM^n = -k^s J dtheta^n
-    fs = rotate_onto_plane(fs, n, 0.5 * spin);
-    mb = rotate_onto_plane(mb, n, 0.5 * spin);
-    store3(bond.fs, fs);
-    store3(bond.mb, mb);
-    bond.mt = mt;
-  }
-
-  // Normal force from the total stretch (tension > 0): exact elastic energy
-  // (the total form of P&C eq. 6's normal increment).
-  const double stretch = len - bond.l0;
-  const double fn = bond.kna * stretch;
-  out.stretch = stretch;
-
-  // Potyondy & Cundall 2004, eq. 7, with the moment-contribution factor beta of
-  // the linear parallel bond (Potyondy 2015, sec. 2; Itasca PFC 5 manual,
-  // "Linear Parallel Bond Model"): extreme stresses on the bond periphery. The
-  // normal force keeps its sign (tension > 0): a compressed bond needs more
-  // bending to fail in tension.
-  const double mb_sq = dot(mb, mb), fs_sq = dot(fs, fs);
-  const double mb_mag = std::sqrt(mb_sq);
-  const double fs_mag = std::sqrt(fs_sq);
-  const double sigma_n = fn * bond.inv_area;  // mean normal stress, tension > 0
-  out.sigma = sigma_n + moment_factor_ * mb_mag * bond.rbond * bond.inv_inertia;
-  out.tau = fs_mag * bond.inv_area +
-            moment_factor_ * std::fabs(mt) * bond.rbond * 0.5 * bond.inv_inertia;
-  // Mohr-Coulomb shear strength on the mean normal stress (same sources:
-  // tau_c = c - sigma_n tan(phi), tension > 0): compression raises it.
-  out.strength = cohesion_ - tan_friction_ * sigma_n;
-  // Elastic energy: fn^2/(2 kn A) + |Fs|^2/(2 ks A) + |Mb|^2/(2 kn I) + Mt^2/(2 ks J);
-  // a bond that breaks now releases it (the energy ledger's "released").
-  const double inv_kn = bond.l0 * inv_modulus_;
-  out.energy = 0.5 * fn * stretch +
-               0.5 * inv_kn *
-                   (stiffness_ratio_ * fs_sq * bond.inv_area + mb_sq * bond.inv_inertia +
-                    stiffness_ratio_ * mt * mt * 0.5 * bond.inv_inertia);
+// Fills out from the law's result of one bond: forces, stresses, the
+// breakage verdict, and what a bond that breaks now releases.
+inline void FixBondBreakable::bond_result(const mill::parallel_bond::Out<double> &o, Vec3 xa, double dt,
+                                          bool advance, BondResult &out) const {
+  out.fa = o.fa;
+  out.ta = o.ta;
+  out.tb = o.tb;
+  out.sigma = o.sigma;
+  out.tau = o.tau;
+  out.strength = o.strength;
+  out.energy = o.energy;
+  out.stretch = o.stretch;
+  out.fdash = o.fdash;
   out.slipped = 0.0;
-  out.fdash = {0.0, 0.0, 0.0};
   out.mode = 0;
   if (out.sigma > tensile_strength_)
     out.mode = 1;
   else if (out.tau > out.strength)
     out.mode = 2;
-  if (out.mode != 0) out.centre = xa + m.ra;  // breaks now: exerts no force from this step on
+  if (out.mode == 0) return;
+  out.centre = xa + o.m.ra;  // breaks now: exerts no force from this step on
+  if (!advance) return;
+  // Released: the energy held now plus the half step of work the bond
+  // would still have done, f . dx / 2 with the half-step velocities (its
+  // force ends between two steps; with this the ledger closes exactly for
+  // a linear spring). A contact left behind keeps its normal push.
+  const PairMotion &m = o.m;
+  const bool keeps_push = broken_contact_ && o.stretch < 0.0;
+  const Vec3 fgone = keeps_push ? o.fs : o.fb;
+  const Vec3 tga = keeps_push ? cross(m.ra, -o.fs) - o.mom : out.ta;
+  const Vec3 tgb = keeps_push ? cross(m.rb, o.fs) + o.mom : out.tb;
+  const double p_half = dot(fgone, m.vrel_ab) + dot(tga, m.wa) + dot(tgb, m.wb);
+  out.released = out.energy - (keeps_push ? 0.5 * o.fn * o.stretch : 0.0) + 0.5 * p_half * dt;
+}
 
-  // Force on b: spring part plus optional viscous part (fraction of critical
-  // damping of the two-body normal / shear oscillator; not part of the stress).
-  Vec3 fb = -fn * n + fs;
-  if (damping_ > 0.0) {
-    fb = fb - (bond.cn * m.vn * n + bond.cs * m.vt);
-    out.fdash = -(bond.cn * m.vn * n + bond.cs * m.vt);
+// Evaluates the bond between atoms a (lower tag) and b in the canonical frame:
+// advances the history in bond when advance is true, then returns forces,
+// torques, stresses and the breakage verdict.
+inline void FixBondBreakable::evaluate_bond(const AtomArrays &at, ListedBond &bond, bool advance,
+                                            BondResult &out) const {
+  mill::parallel_bond::In<double> in;
+  load_bond(at, bond, in);
+  mill::parallel_bond::Out<double> o;
+  mill::parallel_bond::law(in, at.dt, advance, coefficients(), o);
+  if (advance) {
+    store3(bond.fs, o.fs);
+    store3(bond.mb, o.mb);
+    bond.mt = o.mt;
   }
-  out.fa = -fb;
+  bond_result(o, in.xa, at.dt, advance, out);
+}
 
-  // Torques: force at the contact point plus the bond moments (on b: +M).
-  const Vec3 mom = mb + mt * n;
-  out.ta = cross(m.ra, out.fa) - mom;
-  out.tb = cross(m.rb, fb) + mom;
-  if (advance && out.mode != 0) {
-    // Released: the energy held now plus the half step of work the bond
-    // would still have done, f . dx / 2 with the half-step velocities (its
-    // force ends between two steps; with this the ledger closes exactly for
-    // a linear spring). A contact left behind keeps its normal push.
-    const bool keeps_push = broken_contact_ && stretch < 0.0;
-    const Vec3 fgone = keeps_push ? fs : fb;
-    const Vec3 tga = keeps_push ? cross(m.ra, -fs) - mom : out.ta;
-    const Vec3 tgb = keeps_push ? cross(m.rb, fs) + mom : out.tb;
-    const double p_half = dot(fgone, m.vrel_ab) + dot(tga, m.wa) + dot(tgb, m.wb);
-    out.released = out.energy - (keeps_push ? 0.5 * fn * stretch : 0.0) + 0.5 * p_half * dt;
+// evaluate_bond for kLanes<L> intact bonds at once, one per lane of a pack:
+// the same results, bitwise, as one call per bond (tested: BondKernel.*).
+template <class L>
+inline void FixBondBreakable::evaluate_lanes(const AtomArrays &at, ListedBond *const *bonds,
+                                             bool advance, BondResult *outs) const {
+  constexpr int N = kLanes<L>;
+  const double *xa[N], *xb[N], *va[N], *vb[N], *wa[N], *wb[N], *fs[N], *mb[N];
+  mill::parallel_bond::In<L> in;
+  for (int k = 0; k < N; ++k) {
+    const ListedBond &lb = *bonds[k];
+    xa[k] = at.x[lb.a], xb[k] = at.x[lb.b];
+    va[k] = at.v[lb.a], vb[k] = at.v[lb.b];
+    wa[k] = at.omega[lb.a], wb[k] = at.omega[lb.b];
+    fs[k] = lb.fs, mb[k] = lb.mb;
+    in.ra[k] = at.radius[lb.a], in.rb[k] = at.radius[lb.b];
+    in.mt[k] = lb.mt;
+    in.l0[k] = lb.l0, in.kna[k] = lb.kna, in.ksa[k] = lb.ksa, in.kni[k] = lb.kni;
+    in.ksj[k] = lb.ksj, in.inv_area[k] = lb.inv_area, in.inv_inertia[k] = lb.inv_inertia;
+    in.rbond[k] = lb.rbond, in.cn[k] = lb.cn, in.cs[k] = lb.cs;
+  }
+  in.xa = gather3<L>(xa), in.xb = gather3<L>(xb);
+  in.va = gather3<L>(va), in.vb = gather3<L>(vb);
+  in.wa = gather3<L>(wa), in.wb = gather3<L>(wb);
+  in.fs = gather3<L>(fs), in.mb = gather3<L>(mb);
+  mill::parallel_bond::Out<L> o;
+  mill::parallel_bond::law(in, L{} + at.dt, advance, coefficients(), o);
+  // The verdict in all lanes at once: the one-bond comparisons, lane by lane.
+  const auto tension = o.sigma > tensile_strength_;
+  const auto shear = o.tau > o.strength;
+  for (int k = 0; k < N; ++k) {
+    if (advance) {
+      double *f = bonds[k]->fs, *m = bonds[k]->mb;
+      f[0] = o.fs.x[k], f[1] = o.fs.y[k], f[2] = o.fs.z[k];
+      m[0] = o.mb.x[k], m[1] = o.mb.y[k], m[2] = o.mb.z[k];
+      bonds[k]->mt = o.mt[k];
+    }
+    BondResult &out = outs[k];
+    if (tension[k] || shear[k]) {  // breaks now (rare): the one-bond tail
+      bond_result(mill::parallel_bond::lane_of(o, k), lane(in.xa, k), at.dt, advance, out);
+      continue;
+    }
+    // Intact: what finishing an intact bond reads.
+    out.fa = lane(o.fa, k);
+    out.ta = lane(o.ta, k);
+    out.tb = lane(o.tb, k);
+    out.sigma = o.sigma[k];
+    out.tau = o.tau[k];
+    out.strength = o.strength[k];
+    out.energy = o.energy[k];
+    out.stretch = o.stretch[k];
+    out.fdash = lane(o.fdash, k);
+    out.slipped = 0.0;
+    out.mode = 0;
   }
 }
 
@@ -1038,18 +1073,18 @@ void FixBondBreakable::compute_bonds(bool advance) {
     p[1] += v.y;
     p[2] += v.z;
   };
-  auto apply = [&](const ListedBond &lb) {
+  auto apply = [&](const ListedBond &lb, const BondResult &res) {
     const int i = lb.i;
     if (lb.i_lower) {
-      add3(f[i], r.fa);
-      add3(torque[i], r.ta);
+      add3(f[i], res.fa);
+      add3(torque[i], res.ta);
     } else {
-      add3(f[i], -r.fa);
-      add3(torque[i], r.tb);
+      add3(f[i], -res.fa);
+      add3(torque[i], res.tb);
     }
     if (lb.j >= 0) {  // i is the lower tag here: the partner is b.
-      add3(f[lb.j], -r.fa);
-      add3(torque[lb.j], r.tb);
+      add3(f[lb.j], -res.fa);
+      add3(torque[lb.j], res.tb);
     }
   };
   // Queues the slots of list entry lb for removal after the loop (by tag).
@@ -1069,7 +1104,7 @@ void FixBondBreakable::compute_bonds(bool advance) {
       continue;
     }
     evaluate_flat_joint(at, lb, advance, r);
-    apply(lb);
+    apply(lb, r);
     if (lb.state == 0.0 && r.fj_bonded == 0) contact_.push_back(e);  // all elements broken
     if (!lb.i_lower) continue;  // counted once: by the owner of the lower tag
     local[3] += r.energy;  // output 5: the energy in the elements, bonded or pressed
@@ -1093,11 +1128,47 @@ void FixBondBreakable::compute_bonds(bool advance) {
       events_.insert(events_.end(), ev, ev + kEventCols);
     }
   }
+  // An intact bond once evaluated: its break (counted, logged, turned into a
+  // contact or removed) or its force on the atoms.
+  auto finish_bond = [&](int e, ListedBond &lb, const BondResult &res) {
+    if (advance && res.mode != 0) {
+      if (lb.i_lower) {  // counted once: by the owner of the lower tag
+        ledger_.released += res.released;
+        local[res.mode] += 1.0;
+        const double ev[kEventCols] = {
+            static_cast<double>(update->ntimestep),
+            update->get_cur_time(),
+            res.centre.x,
+            res.centre.y,
+            res.centre.z,
+            static_cast<double>(res.mode),
+            static_cast<double>(tag[lb.i]),
+            bonds_[lb.i][lb.slot_i * ncol_ + PARTNER],
+            res.sigma,
+            res.tau};
+        events_.insert(events_.end(), ev, ev + kEventCols);
+      }
+      // A broken bond stays as a contact (broken_contact yes); otherwise it
+      // is removed after the loop (list entries point at slots).
+      if (broken_contact_)
+        contact_.push_back(e);
+      else
+        remove_later(lb);
+      return;
+    }
+    apply(lb, res);
+    if (lb.i_lower) {
+      local[0] += 1.0;
+      local[3] += res.energy;
+      if (damping_ > 0.0) store3(&dash_[3 * e], res.fdash);
+    }
+  };
+  BondResult rs[4];
   for (int e = 0; e < nlisted && !flat_joint_; ++e) {
     ListedBond &lb = list_[e];
     if (lb.state != 0.0) {  // a broken bond kept as a contact
       if (evaluate_contact(at, lb, advance, r)) {
-        apply(lb);
+        apply(lb, r);
         if (lb.i_lower) {
           stored += r.energy;
           ledger_.friction += r.slipped;
@@ -1108,40 +1179,27 @@ void FixBondBreakable::compute_bonds(bool advance) {
       }
       continue;
     }
-    evaluate_bond(at, lb, advance, r);
-
-    if (advance && r.mode != 0) {
-      if (lb.i_lower) {  // counted once: by the owner of the lower tag
-        ledger_.released += r.released;
-        local[r.mode] += 1.0;
-        const double ev[kEventCols] = {
-            static_cast<double>(update->ntimestep),
-            update->get_cur_time(),
-            r.centre.x,
-            r.centre.y,
-            r.centre.z,
-            static_cast<double>(r.mode),
-            static_cast<double>(tag[lb.i]),
-            bonds_[lb.i][lb.slot_i * ncol_ + PARTNER],
-            r.sigma,
-            r.tau};
-        events_.insert(events_.end(), ev, ev + kEventCols);
-      }
-      // A broken bond stays as a contact (broken_contact yes); otherwise it
-      // is removed after the loop (list entries point at slots).
-      if (broken_contact_)
-        contact_.push_back(e);
+    // Intact bonds in a row: evaluated together, kLanes at a time (none
+    // reads what another's finish writes: forces, the break lists), then
+    // finished in list order.
+    int run = 1;
+    while (run < lanes_ && e + run < nlisted && list_[e + run].state == 0.0) ++run;
+    if (run >= 2) {
+      ListedBond *pack[4];
+      const int n = run >= 4 ? 4 : 2;
+      for (int k = 0; k < n; ++k) pack[k] = &list_[e + k];
+      if (n == 4)
+        evaluate_lanes<Lane4>(at, pack, advance, rs);
       else
-        remove_later(lb);
+        evaluate_lanes<Lane2>(at, pack, advance, rs);
+      for (int k = 0; k < n; ++k) finish_bond(e + k, list_[e + k], rs[k]);
+      evals_packed_ += n;
+      e += n - 1;
       continue;
     }
-
-    apply(lb);
-    if (lb.i_lower) {
-      local[0] += 1.0;
-      local[3] += r.energy;
-      if (damping_ > 0.0) store3(&dash_[3 * e], r.fdash);
-    }
+    evaluate_bond(at, lb, advance, r);
+    finish_bond(e, lb, r);
+    evals_single_ += 1.0;
   }
   if (advance) history_dirty_ = true;
   ledger_.elastic = local[3] + stored;
@@ -1328,6 +1386,12 @@ double FixBondBreakable::compute_vector(int n) {
       return energy_;
     case 5:
       return dt_crit_;
+    case 6: {  // share of the intact-bond evaluations made in packs (lanes)
+      const double local[2] = {evals_packed_, evals_single_};
+      double global[2];
+      MPI_Allreduce(local, global, 2, MPI_DOUBLE, MPI_SUM, world);
+      return global[0] + global[1] > 0.0 ? global[0] / (global[0] + global[1]) : 0.0;
+    }
     default:
       return 0.0;
   }

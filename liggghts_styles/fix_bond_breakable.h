@@ -22,6 +22,7 @@
 #include "energy_terms.h"
 #include "fix.h"
 #include "flat_joint.h"
+#include "parallel_bond.h"
 
 namespace LAMMPS_NS {
 
@@ -123,6 +124,10 @@ class FixBondBreakable : public Fix {
   std::string break_log_path_;
   std::string dump_bonds_path_;
   int dump_every_ = 0;
+  int lanes_ = 2;  // intact bonds evaluated at once (1, 2, 4; bond_lanes.h)
+  // Intact-bond evaluations on this rank since the fix was defined: in packs
+  // of lanes, and one at a time (output 7).
+  double evals_packed_ = 0.0, evals_single_ = 0.0;
 
   // Run state (global, written to restart).
   int bonds_created_ = 0;
@@ -209,6 +214,18 @@ class FixBondBreakable : public Fix {
   void create_bonds();
   void compute_bonds(bool advance);
   void evaluate_bond(const AtomArrays &at, ListedBond &bond, bool advance, BondResult &out) const;
+  template <class L>
+  void evaluate_lanes(const AtomArrays &at, ListedBond *const *bonds, bool advance,
+                      BondResult *outs) const;
+  void load_bond(const AtomArrays &at, const ListedBond &bond,
+                 mill::parallel_bond::In<double> &in) const;
+  void bond_result(const mill::parallel_bond::Out<double> &o, mill::bond_geometry::Vec3 xa,
+                   double dt, bool advance, BondResult &out) const;
+  // The coefficients of the parallel bond's law (parallel_bond.h).
+  mill::parallel_bond::Coefficients coefficients() const {
+    return {damping_ > 0.0, moment_factor_, cohesion_, tan_friction_, inv_modulus_,
+            stiffness_ratio_};
+  }
   bool evaluate_contact(const AtomArrays &at, ListedBond &bond, bool advance,
                         BondResult &out) const;
   void evaluate_flat_joint(const AtomArrays &at, ListedBond &bond, bool advance,

@@ -3,6 +3,7 @@
 #include <mpi.h>
 #include <signal.h>
 
+#include <cstdio>
 #include <cstring>
 
 #include "input.h"
@@ -31,6 +32,17 @@ void install_signal_handlers() {
 
 // Runs one LIGGGHTS instance over MPI_COMM_WORLD with the project styles added.
 int main(int argc, char **argv) {
+#if defined(MILL_NEEDS_AVX)
+  // Built with -DMILL_AVX=ON (or AUTO on a machine with AVX): the bond
+  // kernel uses AVX instructions, which this CPU must have.
+  if (!__builtin_cpu_supports("avx")) {
+    std::fprintf(stderr,
+                 "liggghts-mill: this build's bond kernel needs AVX, which this CPU lacks; "
+                 "rebuild with cmake -DMILL_AVX=OFF (docs/styles/fix_bond_breakable.md, "
+                 "\"lanes\")\n");
+    return 1;
+  }
+#endif
   install_signal_handlers();
   MPI_Init(&argc, &argv);
   LAMMPS *lmp = new LAMMPS(argc, argv, MPI_COMM_WORLD);
