@@ -130,8 +130,7 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
     if (iarg + 1 >= narg) fail("keyword '" + key + "' needs a value");
     const char *val = arg[iarg + 1];
     const bool parallel_only =
-        key == "moment_factor" || key == "broken_contact" || key == "contact_moment" ||
-        key == "lanes";
+        key == "moment_factor" || key == "broken_contact" || key == "contact_moment";
     if (flat_joint_ && key == "lanes") {
       fail("keyword 'lanes' packs fix bond/breakable's parallel bonds; a flat joint's " +
            std::string("interfaces are evaluated one at a time: remove it ") +
