@@ -104,7 +104,7 @@ TEST(OreCard, BadCardsAreRejectedThroughTheCase) {
 }
 
 TEST(CaseFile, BundledCasesAreValid) {
-  for (const char* f : {"cases/default.yaml", "cases/reference.yaml", "cases/feed.yaml"}) {
+  for (const char* f : {"cases/default.yaml", "cases/reference.yaml"}) {
     const auto c = load_case(kProject / f, kProject);
     EXPECT_FALSE(c.name.empty());
     EXPECT_EQ(c.ore.str("name"), "sandstone");
@@ -170,7 +170,7 @@ TEST(OreCard, ToughnessInMegapascalsIsNamed) {
 
 // Every bundled ore card and case lies inside the plausible ranges.
 TEST(CaseFile, BundledFilesArePlausible) {
-  for (const char* f : {"cases/default.yaml", "cases/reference.yaml", "cases/feed.yaml",
+  for (const char* f : {"cases/default.yaml", "cases/reference.yaml",
                         "tests/data/tiny_all.yaml",
                         "tests/data/tiny_in_mill.yaml", "tests/data/tiny_hpc.yaml"})
     EXPECT_TRUE(mill::config::outliers(load_case(kProject / f, kProject)).empty()) << f;

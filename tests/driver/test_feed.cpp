@@ -23,7 +23,7 @@ Document parse(const std::string& text) { return Document::parse(text, "f.yaml",
 // A case without feed.* keys has no feed, and its canonical inputs (job ids,
 // the run folder's inputs id) hold no feed key: existing runs keep their ids.
 TEST(Feed, IsOptionalAndAbsentFromTheInputsWithoutOne) {
-  for (const char* f : {"cases/default.yaml", "cases/reference.yaml"}) {
+  for (const char* f : {"cases/reference.yaml"}) {
     const auto c = mill::config::load_case(kProject / f, kProject);
     EXPECT_FALSE(c.feed.has_value()) << f;
     const nlohmann::json inputs = c.doc.to_json();
@@ -32,10 +32,10 @@ TEST(Feed, IsOptionalAndAbsentFromTheInputsWithoutOne) {
   }
 }
 
-// The bundled feed case carries a feed: three classes around its 40 mm
-// lump, a 10 mm grate and a 6 mm P80 target, and its keys are in the inputs.
-TEST(Feed, TheFeedCaseCarriesAFeed) {
-  const auto c = mill::config::load_case(kProject / "cases/feed.yaml", kProject);
+// The default case carries a feed: three classes around its 40 mm lump, a
+// 10 mm grate and a 6 mm P80 target, and its keys are in the inputs.
+TEST(Feed, TheDefaultCaseCarriesAFeed) {
+  const auto c = mill::config::load_case(kProject / "cases/default.yaml", kProject);
   ASSERT_TRUE(c.feed.has_value());
   EXPECT_EQ(c.feed->sizes_mm.back(), 45.0);
   EXPECT_NEAR(c.feed->mass_fractions.back(), 0.5, 1e-12);
