@@ -100,4 +100,24 @@ std::vector<double> crossings_up(const std::vector<std::vector<double>> &rows, i
   return t;
 }
 
+std::string bonded_ball_head(double half_xy, double z_top) {
+  std::ostringstream d;
+  d.precision(17);
+  d << "units si\natom_style sphere\natom_modify map array\nboundary f f f\nnewton off\n"
+    << "communicate single vel yes\nprocessors * 1 1\n"
+    << "region box block " << -half_xy << " " << half_xy << " " << -half_xy << " " << half_xy
+    << " -0.002 " << z_top << " units box\ncreate_box 1 box\n"
+    << "neighbor 0.0003 bin\nneigh_modify delay 0\nhard_particles yes\n"
+    << "fix m1 all property/global youngsModulus peratomtype 5e9\n"
+    << "fix m2 all property/global poissonsRatio peratomtype 0.25\n"
+    << "fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\n"
+    << "fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n"
+    << "pair_style gran model hertz tangential history\npair_coeff * *\n"
+    << "lattice sc " << kL0 << "\n"
+    << "region ball sphere 0 0 0.0105 " << 4.2 * kL0 << " units box\n"
+    << "create_atoms 1 region ball\n"
+    << "set group all diameter " << 2 * kR << " density " << kRho << "\n";
+  return d.str();
+}
+
 }  // namespace mill_test

@@ -45,6 +45,12 @@ std::string bond_fix(const std::string &extra = "", double sigma_t = kSigmaT,
 std::string flat_joint_fix(const std::string &extra = "", double sigma_t = kSigmaT,
                            double cohesion = kCohesion, int rings = 2, int sectors = 4);
 
+// Deck head of a bonded simple-cubic ball (lattice kL0, radius 4.2 kL0,
+// centre at z = 0.0105 m; about 300 elements of radius kR) in a box of
+// half width half_xy from z = -0.002 to z_top, 2 ranks split at x = 0, Hertz
+// contacts; the deck adds velocities, walls, the integrator and the bonds.
+std::string bonded_ball_head(double half_xy, double z_top);
+
 // One sphere of the data file.
 struct Sphere {
   std::array<double, 3> x{};  // position [m]

@@ -41,20 +41,7 @@ LaneRun run_ball(const std::string &name, int lanes, const std::string &keys, in
       make_run_dir("lanes_" + name + "_" + std::to_string(lanes) + "_np" + std::to_string(nprocs));
   std::ostringstream d;
   d.precision(17);
-  d << "units si\natom_style sphere\natom_modify map array\nboundary f f f\nnewton off\n"
-    << "communicate single vel yes\nprocessors * 1 1\n"
-    << "region box block -0.03 0.03 -0.03 0.03 -0.002 0.04 units box\ncreate_box 1 box\n"
-    << "neighbor 0.0003 bin\nneigh_modify delay 0\nhard_particles yes\n"
-    << "fix m1 all property/global youngsModulus peratomtype 5e9\n"
-    << "fix m2 all property/global poissonsRatio peratomtype 0.25\n"
-    << "fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\n"
-    << "fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n"
-    << "pair_style gran model hertz tangential history\npair_coeff * *\n"
-    << "lattice sc " << kL0 << "\n"
-    << "region ball sphere 0 0 0.0105 " << 4.2 * kL0 << " units box\n"
-    << "create_atoms 1 region ball\n"
-    << "set group all diameter " << 2 * kR << " density " << kRho
-    << "\n"
+  d << bonded_ball_head(0.03, 0.04)
     // 12 m/s down, spinning at 800 rad/s about y through the centre
     << "variable vx atom 800*(z-0.0105)\nvariable vz atom -12-800*x\n"
     << "velocity all set v_vx 0 v_vz units box\n"

@@ -407,19 +407,7 @@ std::array<double, 3> run_impact(int nprocs, const std::string &fix = kImpactFix
       make_run_dir("impact" + std::to_string(nprocs) + (fix == kImpactFix ? "" : "fj"));
   std::ostringstream d;
   d.precision(17);
-  d << "units si\natom_style sphere\natom_modify map array\nboundary f f f\nnewton off\n"
-    << "communicate single vel yes\nprocessors * 1 1\n"
-    << "region box block -0.02 0.02 -0.02 0.02 -0.002 0.03 units box\ncreate_box 1 box\n"
-    << "neighbor 0.0003 bin\nneigh_modify delay 0\nhard_particles yes\n"
-    << "fix m1 all property/global youngsModulus peratomtype 5e9\n"
-    << "fix m2 all property/global poissonsRatio peratomtype 0.25\n"
-    << "fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\n"
-    << "fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n"
-    << "pair_style gran model hertz tangential history\npair_coeff * *\n"
-    << "lattice sc " << kL0 << "\n"
-    << "region ball sphere 0 0 0.0105 " << 4.2 * kL0 << " units box\n"
-    << "create_atoms 1 region ball\n"
-    << "set group all diameter " << 2 * kR << " density " << kRho << "\n"
+  d << bonded_ball_head(0.02, 0.03)
     << "velocity all set 0 0 -10 units box\n"
     << "fix wall all wall/gran model hertz tangential history primitive type 1 zplane 0.0\n"
     << "fix integr all nve/sphere\n"
