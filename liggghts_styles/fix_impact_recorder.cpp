@@ -17,6 +17,9 @@
 #include "comm.h"
 #include "error.h"
 #include "fix_mesh.h"
+#include "fix_mesh_surface.h"
+#include "fix_neighlist_mesh.h"
+#include "fix_property_atom.h"
 #include "memory.h"
 #include "modify.h"
 #include "style_args.h"
@@ -107,7 +110,7 @@ void closest_on_triangle(const double *p, const double *a, const double *b, cons
 FixImpactRecorder::FixImpactRecorder(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg) {
   parse_args(narg, arg);
   vector_flag = 1;
-  size_vector = 1 + static_cast<int>(surfaces_.size());
+  size_vector = 2 + static_cast<int>(surfaces_.size());
   global_freq = 1;
   extvector = 0;
   create_attribute = 1;
@@ -186,8 +189,10 @@ void FixImpactRecorder::parse_args(int narg, char **arg) {
     } else if (key == "prefilter") {
       need(iarg, 1, key);
       const std::string v = arg[iarg + 1];
-      if (v != "yes" && v != "no") fail("prefilter must be yes or no, got '" + v + "'");
-      prefilter_ = v == "yes";
+      if (v != "yes" && v != "grid" && v != "no")
+        fail("prefilter must be yes, grid or no, got '" + v + "'");
+      prefilter_ = v != "no";
+      neighfilter_ = v == "yes";
       iarg += 2;
     } else if (key == "pending") {
       need(iarg, 2, key);
@@ -540,6 +545,24 @@ bool FixImpactRecorder::nearest_point(Surface &s, const double *x, double radius
   return found;
 }
 
+// With the pre-filter `yes`: the per-atom count of the triangles of s whose
+// neighbour list (LIGGGHTS' fix neighlist/mesh, the one fix wall/gran uses)
+// holds the atom, and the group bit of the atoms those lists look at; null
+// when the mesh has no such list (no wall/gran fix uses it). The lists are
+// conservative: a particle in none of them is farther than its radius plus
+// the neighbour skin from every triangle when they were built, and neither it
+// nor the mesh has moved by more than half the skin since (LIGGGHTS rebuilds
+// them then), so it touches no triangle now.
+Fix *FixImpactRecorder::mesh_neighbour_counts(const Surface &s, int *wall_groupbit) const {
+  auto *surface = dynamic_cast<FixMeshSurface *>(s.mesh);
+  if (!surface || !surface->hasNeighList()) return nullptr;
+  FixNeighlistMesh *list = surface->meshNeighlist();
+  FixPropertyAtom *counts = list ? list->fix_nneighs() : nullptr;
+  if (!counts || !counts->vector_atom) return nullptr;
+  *wall_groupbit = list->groupbit_wall_mesh;
+  return counts;
+}
+
 // Velocity w of surface s at point c (Omega x r, r from the axis to c; zero
 // for a fixed surface) and the distance of c from the axis.
 void FixImpactRecorder::surface_velocity(const Surface &s, const double *c, double *w,
@@ -659,13 +682,25 @@ void FixImpactRecorder::end_of_step() {
   const int *mask = atom->mask;
   if (prefilter_) set_query_reach();
   for (auto &s : surfaces_) s.loaded = false;  // triangles are fetched lazily
+  const size_t ns = surfaces_.size();
+  Fix *nneigh[kMaxSurfaces] = {nullptr};
+  int wallbit[kMaxSurfaces] = {0};
+  if (neighfilter_)
+    for (size_t is = 0; is < ns; ++is)
+      nneigh[is] = mesh_neighbour_counts(surfaces_[is], &wallbit[is]);
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
     int bits = static_cast<int>(state_[i][0]), onsets = 0;
-    for (size_t is = 0; is < surfaces_.size(); ++is) {
+    for (size_t is = 0; is < ns; ++is) {
       double c[3];
       const int bit = 1 << is;
-      if (nearest_point(surfaces_[is], x[i], radius[i], c)) {
+      // In no triangle's neighbour list of the mesh: farther than its radius
+      // from every triangle (the lists hold every particle within radius +
+      // skin, and are rebuilt before anything moves by half the skin).
+      const bool listed =
+          !nneigh[is] || !(mask[i] & wallbit[is]) || nneigh[is]->get_vector_atom_int(i) > 0;
+      tests_[listed ? 0 : 1] += 1.0;
+      if (listed && nearest_point(surfaces_[is], x[i], radius[i], c)) {
         if (!(bits & bit)) {
           record(surfaces_[is], static_cast<int>(is), i, c);
           state_[i][1 + is] = update->get_cur_time();
@@ -748,8 +783,15 @@ void FixImpactRecorder::flush_events() {
   MPI_Bcast(counts_.data(), static_cast<int>(counts_.size()), MPI_DOUBLE, 0, world);
 }
 
-// 1: impacts recorded so far, 1 + s: impacts on surface s (in keyword order).
+// 1: impacts recorded so far, 1 + s: impacts on surface s (in keyword order),
+// then the share of particle-surface tests since the fix was made that the
+// mesh neighbour lists spared (all ranks; 0 before the first test).
 double FixImpactRecorder::compute_vector(int n) {
+  if (n == size_vector - 1) {
+    double all[2] = {0.0, 0.0};
+    MPI_Allreduce(tests_, all, 2, MPI_DOUBLE, MPI_SUM, world);
+    return all[0] + all[1] > 0.0 ? all[1] / (all[0] + all[1]) : 0.0;
+  }
   return n >= 0 && n < static_cast<int>(counts_.size()) ? counts_[n] : 0.0;
 }
 

@@ -124,6 +124,8 @@ class FixImpactRecorder : public Fix {
   std::string ends_path_;                    // contact_ends CSV ("" = no end records)
   FILE *ends_file_ = nullptr;                // rank 0 only
   bool prefilter_ = true;                    // test only the triangles of the particle's bin
+  bool neighfilter_ = true;                  // skip particles in no mesh neighbour list
+  double tests_[2] = {0.0, 0.0};             // this rank's particle-surface tests: made, skipped
   std::string pending_names_[2];             // `pending FROM TO` ("" = none)
   int pending_from_ = -1, pending_to_ = -1;  // their surface indices
   double query_reach_ = 0.0;                 // largest query radius this step on this rank [m]
@@ -146,6 +148,7 @@ class FixImpactRecorder : public Fix {
   void set_query_reach();
   void build_grid(Surface &s);
   void set_bound(Surface &s);
+  Fix *mesh_neighbour_counts(const Surface &s, int *wall_groupbit) const;
   bool nearest_point(Surface &s, const double *x, double radius, double *c);
   bool grid_candidates(const Surface &s, const double *x, const int **first,
                        const int **last) const;

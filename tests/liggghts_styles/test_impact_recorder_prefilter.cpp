@@ -1,7 +1,9 @@
-// Tests of fix impact/recorder's pre-filter (the grid of bins that lets a
+// Tests of fix impact/recorder's pre-filters (the mesh neighbour lists that
+// spare particles far from a surface, and the grid of bins that lets a
 // particle be tested only against the triangles near it): the same real
-// liggghts-mill run with `prefilter yes` and `prefilter no` must write the
-// same impact and contact-end CSVs, byte for byte.
+// liggghts-mill run with `prefilter yes` (both), `grid` (the grid only) and
+// `no` (every triangle) must write the same impact and contact-end CSVs, byte
+// for byte.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -44,7 +46,8 @@ int count_rows(const std::string &text, const std::string &surface) {
 }
 
 // The first line where two texts differ, for the failure message.
-std::string first_difference(const std::string &a, const std::string &b) {
+std::string first_difference(const std::string &a, const std::string &b, const std::string &name_a,
+                             const std::string &name_b) {
   std::istringstream ia(a), ib(b);
   std::string la, lb;
   for (int line = 1;; ++line) {
@@ -52,29 +55,48 @@ std::string first_difference(const std::string &a, const std::string &b) {
     const bool gb = static_cast<bool>(std::getline(ib, lb));
     if (!ga && !gb) return "none";
     if (!ga || !gb || la != lb)
-      return "line " + std::to_string(line) + ":\n  prefilter yes: " + (ga ? la : "(end)") +
-             "\n  prefilter no:  " + (gb ? lb : "(end)");
+      return "line " + std::to_string(line) + ":\n  prefilter " + name_a + ": " +
+             (ga ? la : "(end)") + "\n  prefilter " + name_b + ": " + (gb ? lb : "(end)");
   }
 }
 
+constexpr int kModes = 3;
+const char *const kMode[kModes] = {"yes", "grid", "no"};
+
 struct Outputs {
   std::string impacts, ends;
+  double spared = -1.0;  // the recorder's last output: share of tests the lists spared
 };
 
-// Runs `deck` (whose recorder line holds PREFILTER) with the pre-filter on and
-// off on nprocs ranks; files are written to the run directories.
-void run_both(const std::string &name, const std::string &deck, int nprocs,
-              void (*write_inputs)(const std::string &dir), Outputs out[2]) {
-  const char *value[2] = {"yes", "no"};
-  for (int k = 0; k < 2; ++k) {
-    const std::string dir = make_run_dir(name + "_" + value[k]);
+// Runs `deck` (whose recorder line holds PREFILTER, and which ends by printing
+// "spared <f_rec's last element>") with each pre-filter on nprocs ranks;
+// files are written to the run directories.
+void run_modes(const std::string &name, const std::string &deck, int nprocs,
+               void (*write_inputs)(const std::string &dir), Outputs out[kModes]) {
+  for (int k = 0; k < kModes; ++k) {
+    const std::string dir = make_run_dir(name + "_" + kMode[k]);
     write_inputs(dir);
     std::string d = deck;
-    d.replace(d.find("PREFILTER"), 9, value[k]);
+    d.replace(d.find("PREFILTER"), 9, kMode[k]);
     const auto r = run_deck(dir, d, nprocs);
     ASSERT_EQ(r.exit_code, 0) << r.screen;
     out[k].impacts = slurp(dir + "/impacts.csv");
     out[k].ends = slurp(dir + "/contact_ends.csv");
+    const size_t at = r.screen.rfind("spared ");
+    ASSERT_NE(at, std::string::npos) << r.screen;
+    out[k].spared = std::stod(r.screen.substr(at + 7));
+  }
+}
+
+// Every mode's CSVs equal those of `prefilter no` (the last).
+void expect_same_records(const Outputs out[kModes], const std::string &what) {
+  for (int k = 0; k + 1 < kModes; ++k) {
+    EXPECT_TRUE(out[k].impacts == out[kModes - 1].impacts)
+        << what << ", impacts.csv: "
+        << first_difference(out[k].impacts, out[kModes - 1].impacts, kMode[k], "no");
+    EXPECT_TRUE(out[k].ends == out[kModes - 1].ends)
+        << what << ", contact_ends.csv: "
+        << first_difference(out[k].ends, out[kModes - 1].ends, kMode[k], "no");
   }
 }
 
@@ -103,9 +125,9 @@ void write_mill(const std::string &dir) {
 
 // A cloud of spheres falling into the turning flywheel of the tiny mill and
 // flung into its housing.
-std::string mill_deck(int nprocs) {
+std::string mill_deck(int nprocs, const std::string &boundary) {
   const double omega = 2000 * 2 * kPi / 60;
-  std::string head = deck_head(0.65);
+  std::string head = deck_head(0.65, 5e9, boundary);
   const size_t r0 = head.find("region box"), r1 = head.find('\n', r0);
   head.replace(r0, r1 - r0, "region box block -0.45 0.45 -0.05 1.25 -0.2 0.2 units box");
   if (nprocs == 2) head.insert(head.find("region box"), "processors 2 1 1\n");
@@ -136,7 +158,8 @@ std::string mill_deck(int nprocs) {
     << "fix rec all impact/recorder file impacts.csv ends contact_ends.csv prefilter PREFILTER "
     << "surface flywheel mesh fw omega " << omega << " origin 0 0.45 0 axis 0 0 1 "
     << "surface housing mesh hs\n"
-    << "timestep 2e-6\nthermo 1000\nthermo_modify lost ignore\nrun 9000\n";
+    << "timestep 2e-6\nthermo 1000\nthermo_modify lost ignore\nrun 9000\n"
+    << "variable spared equal f_rec[4]\nprint \"spared ${spared}\"\n";
   return s.str();
 }
 
@@ -144,26 +167,35 @@ std::string mill_deck(int nprocs) {
 
 // Spheres falling into the tiny mill's turning flywheel (fix move/mesh, as in
 // the in-mill deck) and flung into its housing: onsets and contact ends on
-// the flywheel and the housing, identical as text with and without the
-// pre-filter, on one rank and on two (the triangles of owned and ghost
-// elements on each rank).
+// the flywheel and the housing, identical as text with each pre-filter, on
+// one rank and on two (the triangles of owned and ghost elements on each
+// rank), in a fixed box (the housing's neighbour lists from precomputed bins,
+// half the skin) and a shrink-wrapped one as the in-mill deck's (every
+// triangle's box of bins, the whole skin). The neighbour lists must spare
+// most tests, or the comparison says nothing about them.
 TEST(ImpactRecorderPrefilter, SameRecordsInTurningMill) {
-  for (int np = 1; np <= 2; ++np) {
-    Outputs out[2];
-    run_both("prefilter_mill" + std::to_string(np), mill_deck(np), np, write_mill, out);
+  const struct {
+    int np;
+    const char *boundary;
+  } runs[] = {{1, "f f f"}, {2, "f f f"}, {1, "m m m"}};
+  for (const auto &run : runs) {
+    const std::string what = std::to_string(run.np) + " rank(s), boundary " + run.boundary;
+    Outputs out[kModes];
+    run_modes("prefilter_mill" + std::to_string(run.np) + run.boundary[0],
+              mill_deck(run.np, run.boundary), run.np, write_mill, out);
     if (HasFatalFailure()) return;
     const int fw = count_rows(out[0].impacts, "flywheel"),
               hs = count_rows(out[0].impacts, "housing");
     const int ends = count_rows(out[0].ends, "flywheel") + count_rows(out[0].ends, "housing");
-    std::printf("%d rank(s): %d flywheel and %d housing onsets, %d contact ends\n", np, fw, hs,
-                ends);
-    EXPECT_GE(fw, 20) << "too few flywheel strikes to compare";
-    EXPECT_GE(hs, 10) << "too few housing impacts to compare";
-    EXPECT_GE(ends, 40) << "too few contact ends to compare";
-    EXPECT_TRUE(out[0].impacts == out[1].impacts)
-        << np << " rank(s), impacts.csv: " << first_difference(out[0].impacts, out[1].impacts);
-    EXPECT_TRUE(out[0].ends == out[1].ends)
-        << np << " rank(s), contact_ends.csv: " << first_difference(out[0].ends, out[1].ends);
+    std::printf("%s: %d flywheel and %d housing onsets, %d contact ends; the lists spared %.3f\n",
+                what.c_str(), fw, hs, ends, out[0].spared);
+    EXPECT_GE(fw, 20) << what << ": too few flywheel strikes to compare";
+    EXPECT_GE(hs, 10) << what << ": too few housing impacts to compare";
+    EXPECT_GE(ends, 40) << what << ": too few contact ends to compare";
+    EXPECT_GT(out[0].spared, 0.5) << what;
+    EXPECT_EQ(out[1].spared, 0.0) << what << ": prefilter grid uses no lists";
+    EXPECT_EQ(out[2].spared, 0.0) << what << ": prefilter no uses no lists";
+    expect_same_records(out, what);
   }
 }
 
@@ -216,22 +248,18 @@ TEST(ImpactRecorderPrefilter, TriangleOverManyBins) {
     << "fix integr all nve/sphere\n"
     << "fix rec all impact/recorder file impacts.csv ends contact_ends.csv prefilter PREFILTER "
        "surface floor mesh plane\n"
-    << "timestep 1e-6\nthermo 1000\nrun 3000\n";
-  Outputs out[2];
-  run_both("prefilter_bins", s.str(), 1, write_square_and_strip, out);
+    << "timestep 1e-6\nthermo 1000\nrun 3000\n"
+    << "variable spared equal f_rec[3]\nprint \"spared ${spared}\"\n";
+  Outputs out[kModes];
+  run_modes("prefilter_bins", s.str(), 1, write_square_and_strip, out);
   if (HasFatalFailure()) return;
-  const int on[2] = {count_rows(out[0].impacts, "floor"), count_rows(out[1].impacts, "floor")};
-  const int off[2] = {count_rows(out[0].ends, "floor"), count_rows(out[1].ends, "floor")};
-  std::printf("onsets %d (yes) %d (no), ends %d (yes) %d (no), of 81 spheres\n", on[0], on[1],
-              off[0], off[1]);
-  EXPECT_EQ(on[1], 81);
-  EXPECT_EQ(off[1], 81);
-  EXPECT_EQ(on[0], 81);
-  EXPECT_EQ(off[0], 81);
-  EXPECT_TRUE(out[0].impacts == out[1].impacts)
-      << "impacts.csv: " << first_difference(out[0].impacts, out[1].impacts);
-  EXPECT_TRUE(out[0].ends == out[1].ends)
-      << "contact_ends.csv: " << first_difference(out[0].ends, out[1].ends);
+  for (int k = 0; k < kModes; ++k) {
+    std::printf("prefilter %s: onsets %d, ends %d of 81 spheres\n", kMode[k],
+                count_rows(out[k].impacts, "floor"), count_rows(out[k].ends, "floor"));
+    EXPECT_EQ(count_rows(out[k].impacts, "floor"), 81) << kMode[k];
+    EXPECT_EQ(count_rows(out[k].ends, "floor"), 81) << kMode[k];
+  }
+  expect_same_records(out, "square and strip");
 }
 
 // A wrong value of the keyword is named with what it accepts.
@@ -243,6 +271,6 @@ TEST(ImpactRecorderPrefilter, BadValueIsNamed) {
                "fix rec all impact/recorder file impacts.csv prefilter maybe surface floor mesh "
                "plane\nrun 0\n");
   EXPECT_NE(r.exit_code, 0);
-  EXPECT_NE(r.screen.find("prefilter must be yes or no, got 'maybe'"), std::string::npos)
+  EXPECT_NE(r.screen.find("prefilter must be yes, grid or no, got 'maybe'"), std::string::npos)
       << r.screen;
 }
