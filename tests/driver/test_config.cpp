@@ -5,6 +5,7 @@
 
 #include "config/case_config.h"
 #include "config/schema.h"
+#include "stages/breakage/lump_run.h"
 
 namespace fs = std::filesystem;
 using mill::config::ConfigError;
@@ -251,3 +252,26 @@ TEST(EditDistance, Basics) {
 }
 
 }  // namespace
+
+// The adaptive step is on by default and acts on the automatic step only: a
+// case that gives breakage.timestep keeps one step (and is valid), one that
+// asks for both is refused (tests/bad_input/adaptive_step_with_timestep.yaml),
+// and `false` turns it off.
+TEST(CaseFile, AdaptiveStepIsTheDefaultWithTheAutomaticStep) {
+  const fs::path dir = fs::temp_directory_path() / "mill_adaptive_default";
+  fs::create_directories(dir);
+  struct {
+    const char *text;
+    bool on;
+  } cases[] = {{"name: a\n", true},
+               {"name: b\nbreakage:\n  timestep: 1.0e-7\n", false},
+               {"name: c\nbreakage:\n  adaptive_step: false\n", false},
+               {"name: d\nbreakage:\n  adaptive_step: true\n", true}};
+  for (const auto &c : cases) {
+    const fs::path f = dir / "case.yaml";
+    std::ofstream(f) << c.text;
+    const auto cfg = load_case(f, kProject);
+    EXPECT_EQ(mill::breakage::adaptive_step_on(cfg.doc), c.on) << c.text;
+  }
+  fs::remove_all(dir);
+}

@@ -55,9 +55,9 @@ void plot_energy_ledger(StageContext& ctx, const fs::path& out_dir, double veloc
 nlohmann::json impact_base_inputs(const StageContext& ctx) {
   nlohmann::json base = case_keys(ctx.cfg.doc, {"lump.", "breakage.duration_after_contact",
                                                 "breakage.timestep", "breakage.quiet_time"});
-  // The adaptive step is an input only when on: impacts with the fixed step
-  // keep their job ids.
-  if (ctx.cfg.doc.boolean("breakage.adaptive_step")) base["breakage.adaptive_step"] = true;
+  // The adaptive step is an input only when in effect: impacts with the
+  // fixed step keep their job ids.
+  if (adaptive_step_on(ctx.cfg.doc)) base["breakage.adaptive_step"] = true;
   base["ore"] = config::ore_keys(ctx.cfg.ore);
   base["bond"] = bond_json(bond_params_for(ctx.cfg, ctx.run_dir), BondNames::job);
   // Bumped whenever the impact deck or the bond style changes what a run
@@ -138,7 +138,7 @@ std::string run_impact(StageContext& ctx, double velocity, double angle, int rep
               {"quiet_time", num(d.real("breakage.quiet_time"))},
               {"dt", num(dt_given)},
               {"dt_speed", num(dt_speed)},
-              {"adaptive_step", d.boolean("breakage.adaptive_step") ? "1" : "0"},
+              {"adaptive_step", adaptive_step_on(d) ? "1" : "0"},
               {"skin", num(0.3 * lump.mean_radius)},
               {"binsize", num(4.0 * lump.mean_radius)},
               {"dump_interval", num(d.real("breakage.dump_interval"))}};

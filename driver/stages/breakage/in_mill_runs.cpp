@@ -132,7 +132,7 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan,
   nlohmann::json base = case_keys(d, keys);
   // The adaptive step is an input only when on: runs with the fixed step
   // keep their job ids.
-  if (d.boolean("breakage.adaptive_step")) base["breakage.adaptive_step"] = true;
+  if (adaptive_step_on(d)) base["breakage.adaptive_step"] = true;
   base["ore"] = config::ore_keys(ctx.cfg.ore);
   base["bond"] = bond_json(bond_params_for(ctx.cfg, ctx.run_dir), BondNames::job);
   base["in_mill_deck_version"] = kInMillDeckVersion;
@@ -278,7 +278,7 @@ std::vector<std::pair<std::string, std::string>> in_mill_vars(
       {"stop_margin", num(in.at("lump.diameter").get<double>())},
       {"dt", num(d.real("breakage.timestep"))},
       {"dt_speed", num(step.dt_speed)},
-      {"adaptive_step", d.boolean("breakage.adaptive_step") ? "1" : "0"},
+      {"adaptive_step", adaptive_step_on(d) ? "1" : "0"},
       {"skin", num(kSkinRadii * lr.lump.mean_radius)},
       {"binsize", num(first_bin(d, g, lr))},
       {"dump_interval", num(d.real("breakage.dump_interval"))},

@@ -23,6 +23,10 @@
 #include "stages/stage_util.h"
 
 namespace mill::breakage {
+
+bool adaptive_step_on(const config::Document& d) {
+  return d.boolean("breakage.adaptive_step") && d.real("breakage.timestep") == 0.0;
+}
 namespace fs = std::filesystem;
 using engine::num;
 

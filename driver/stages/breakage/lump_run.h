@@ -39,6 +39,11 @@ struct LumpRun {
 LumpRun prepare_lump_run(StageContext& ctx, int repeat, const std::filesystem::path& out_dir,
                          const std::string& label, int set = 1, const LumpSpec* spec = nullptr);
 
+// Whether the impact and in-mill decks re-evaluate their step between chunks
+// (fix step/adaptive): breakage.adaptive_step with the automatic step
+// (breakage.timestep 0); a given step stays fixed.
+bool adaptive_step_on(const config::Document& d);
+
 // -var pairs every lump deck takes: the shared deck pieces' folder, the lump
 // file, its orientation, the bonding rule, the ore and the bonds.
 std::vector<std::pair<std::string, std::string>> lump_deck_vars(const StageContext& ctx,
