@@ -114,7 +114,7 @@ FixImpactRecorder::FixImpactRecorder(LAMMPS *lmp, int narg, char **arg) : Fix(lm
   global_freq = 1;
   extvector = 0;
   create_attribute = 1;
-  counts_.assign(size_vector, 0.0);
+  counts_.assign(1 + surfaces_.size(), 0.0);  // the last output is computed
 
   ncols_ = 1 + static_cast<int>(surfaces_.size());
   if (pending_from_ >= 0) {

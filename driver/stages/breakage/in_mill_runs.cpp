@@ -130,8 +130,8 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan,
   if (gas)
     for (const char* p : {"gas.", "flow.", "sample."}) keys.push_back(p);
   nlohmann::json base = case_keys(d, keys);
-  // The adaptive step is an input only when on: runs with the fixed step
-  // keep their job ids.
+  // The adaptive step is an input only when in effect: runs with the fixed
+  // step keep their job ids.
   if (adaptive_step_on(d)) base["breakage.adaptive_step"] = true;
   base["ore"] = config::ore_keys(ctx.cfg.ore);
   base["bond"] = bond_json(bond_params_for(ctx.cfg, ctx.run_dir), BondNames::job);
