@@ -345,6 +345,7 @@ int run_stage(const StagePass& p, const Invocation& inv, std::ostream& out) {
   } else {
     todo = p.rows;
   }
+  for (const auto& w : p.plan.warnings) p.ctx.progress.warn(w);
   p.ctx.progress.stage_begin(
       name, static_cast<int>(todo.size()),
       static_cast<int>(std::count_if(todo.begin(), todo.end(), [](const JobRow& r) {

@@ -601,7 +601,18 @@ Schema make_ore_schema() {
     if (p.calibrated)
       s.keys.push_back(opt(bond_key(cal + p.calibrated, p, "")));
   s.keys.push_back(opt(key(std::string(kCalibratedSection) + "." + kInputHashKey, T::String, "", "",
-                           "Hash of the macro properties these were fitted to")));
+                           "Hash of what these were fitted to: the card's macro properties (and K_IC when a "
+                           "target), the lump's element size and bonding range")));
+  // The lump scale they were fitted for (lump/material.h, lump_scale): it
+  // names what differs when the section does not apply to a case.
+  const std::string ff = cal + kFittedForKey + ".";
+  s.keys.push_back(opt(positive(key(ff + "element_radius_m", T::Real, "m", "",
+                                    "Mean element radius the calibration was fitted at (from lump.n_elements, "
+                                    "lump.diameter, lump.radius_spread)"))));
+  s.keys.push_back(opt(key(ff + "radius_spread", T::Real, "", "", "lump.radius_spread of that fit")));
+  s.keys.push_back(opt(key(ff + "bond_gap", T::Real, "", "", "lump.bond_gap of that fit")));
+  s.keys.push_back(opt(key(ff + "bond_radius_multiplier", T::Real, "", "", "lump.bond_radius_multiplier of that fit")));
+  s.keys.push_back(opt(key(ff + "broken_contact", T::Bool, "", "", "lump.broken_contact of that fit (parallel bond)")));
   return s;
 }
 

@@ -96,7 +96,8 @@ nlohmann::json bond_json(const BondParams& b, BondNames names) {
 }
 
 // calibrated: {fitted rows..., input_hash}, as calibrated.yaml writes it.
-void emit_calibrated(YAML::Emitter& y, const BondParams& b, const std::string& hash) {
+void emit_calibrated(YAML::Emitter& y, const BondParams& b, const std::string& hash,
+                     const nlohmann::json& fitted_for) {
   y << YAML::Key << kCalibratedSection << YAML::Value << YAML::BeginMap;
   y << YAML::Key << kModelKey << YAML::Value << bond_model_name(b.model);
   if (b.model == BondModel::flat_joint) {
@@ -106,6 +107,17 @@ void emit_calibrated(YAML::Emitter& y, const BondParams& b, const std::string& h
   for (const BondParameter& p : kBondParameters)
     if (p.calibrated && uses(b, p)) y << YAML::Key << p.calibrated << YAML::Value << b.*p.value;
   y << YAML::Key << kInputHashKey << YAML::Value << hash;
+  if (fitted_for.is_object()) {
+    y << YAML::Key << kFittedForKey << YAML::Value << YAML::BeginMap;
+    for (const auto& [k, v] : fitted_for.items()) {
+      y << YAML::Key << k << YAML::Value;
+      if (v.is_boolean())
+        y << v.get<bool>();
+      else
+        y << v.get<double>();
+    }
+    y << YAML::EndMap;
+  }
   y << YAML::EndMap;
 }
 

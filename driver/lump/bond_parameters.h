@@ -124,6 +124,10 @@ inline constexpr const char* kInputHashKey = "input_hash";
 inline constexpr const char* kModelKey = "bond_model";
 inline constexpr const char* kRingsKey = "joint_rings";
 inline constexpr const char* kSectorsKey = "joint_sectors";
+// Its map of the lump scale the parameters were fitted for (lump/material.h,
+// lump_scale): informative, the input_hash already covers it; it names what
+// differs when a section does not apply to a case.
+inline constexpr const char* kFittedForKey = "fitted_for";
 
 // The row whose job JSON key is `json`; throws std::logic_error for none.
 inline const BondParameter& bond_parameter(std::string_view json) {
@@ -142,8 +146,11 @@ nlohmann::json bond_json(const BondParams& b, BondNames names);
 
 // The calibrated: map of calibrated.yaml (and of the ore card) as a YAML map
 // entry: the fitted rows in table order, then the input hash `hash` (the
-// ore_hash of the card they were fitted to).
-void emit_calibrated(YAML::Emitter& y, const BondParams& b, const std::string& hash);
+// calibration_hash of the card and lump they were fitted to) and, when not
+// null, `fitted_for` (a flat JSON map of numbers and booleans: the lump's
+// scale, lump_scale).
+void emit_calibrated(YAML::Emitter& y, const BondParams& b, const std::string& hash,
+                     const nlohmann::json& fitted_for = nullptr);
 
 // `base` with the fitted rows replaced by those of a calibrated: map (a YAML
 // node, or the card's calibrated.* keys); an optional row that is absent

@@ -8,6 +8,7 @@
 
 #include "engine/liggghts.h"
 #include "jobs/job_store.h"
+#include "lump/packing.h"
 
 namespace mill {
 namespace fs = std::filesystem;
@@ -20,10 +21,24 @@ bool fits_toughness(const config::CaseConfig& cfg) {
          cfg.ore.has("fracture_toughness");
 }
 
+nlohmann::json lump_scale(const config::CaseConfig& cfg) {
+  const config::Document& d = cfg.doc;
+  // Six significant digits: the same lump gives the same radius on any
+  // machine, and a lump of 8 x the elements in 2 x the diameter the same.
+  const double r = target_mean_radius(d.integer("lump.n_elements"), d.real("lump.diameter"),
+                                      d.real("lump.radius_spread"));
+  nlohmann::json s = {{"element_radius_m", std::stod(fmt::format("{:.6g}", r))},
+                      {"radius_spread", d.real("lump.radius_spread")},
+                      {"bond_gap", d.real("lump.bond_gap")},
+                      {"bond_radius_multiplier", d.real("lump.bond_radius_multiplier")}};
+  if (bond_model_from(d.str("lump.bond_model")) == BondModel::parallel)
+    s["broken_contact"] = d.boolean("lump.broken_contact");
+  return s;
+}
+
 std::string calibration_hash(const config::CaseConfig& cfg) {
-  if (!fits_toughness(cfg)) return ore_hash(cfg.ore);
-  nlohmann::json keys = config::ore_keys(cfg.ore);
-  keys["fracture_toughness"] = cfg.ore.real("fracture_toughness");
+  nlohmann::json keys = {{"ore", config::ore_keys(cfg.ore)}, {"lump_scale", lump_scale(cfg)}};
+  if (fits_toughness(cfg)) keys["fracture_toughness"] = cfg.ore.real("fracture_toughness");
   return jobs::job_id(keys);
 }
 
@@ -80,6 +95,65 @@ bool read_calibrated_file(const fs::path& file, const std::string& hash, BondPar
   return true;
 }
 }  // namespace
+
+namespace {
+// What a calibrated: map `c` (complete, with another input_hash than the
+// case's, or another model) was fitted for, against the case: one clause.
+std::string mismatch(const YAML::Node& c, const config::CaseConfig& cfg) {
+  const BondParams want = estimate_bond_params(cfg.ore, cfg.doc);
+  const BondParams got = read_calibrated(c, want);
+  if (!same_model(got, want))
+    return fmt::format("fitted with the {}, the case uses the {} (lump.bond_model, lump.joint_*)",
+                       bond_model_text(got), bond_model_text(want));
+  const YAML::Node f = c[kFittedForKey];
+  if (!f || !f.IsMap())
+    return "fitted to other card properties, or by a version that did not record the lump's scale "
+           "(calibrated.fitted_for)";
+  const nlohmann::json scale = lump_scale(cfg);
+  std::vector<std::string> diffs;
+  for (const auto& [k, v] : scale.items()) {
+    if (!f[k]) continue;
+    const std::string mine = v.is_boolean() ? (v.get<bool>() ? "true" : "false")
+                                            : fmt::format("{:.6g}", v.get<double>());
+    const std::string theirs = f[k].as<std::string>();
+    const bool same = v.is_boolean() ? theirs == mine
+                                     : std::abs(f[k].as<double>() - v.get<double>()) <=
+                                           1e-6 * std::abs(v.get<double>());
+    if (!same) diffs.push_back(fmt::format("{} {} (this case: {})", k, theirs, mine));
+  }
+  if (diffs.empty()) return "fitted to other card properties (its input_hash is another)";
+  std::string out = "fitted for another lump scale: ";
+  for (size_t i = 0; i < diffs.size(); ++i) out += (i ? ", " : "") + diffs[i];
+  return out +
+         "; the scale follows lump.n_elements, lump.diameter, lump.radius_spread, "
+         "lump.bond_gap, lump.bond_radius_multiplier and lump.broken_contact";
+}
+
+// Why `file` gives no calibration for the case; empty when it does.
+std::string file_reason(const fs::path& file, const config::CaseConfig& cfg, const char* what) {
+  if (!fs::exists(file)) return fmt::format("no {} ({})", what, file.string());
+  try {
+    const YAML::Node root = YAML::LoadFile(file.string());
+    const YAML::Node c = root.IsMap() ? root[kCalibratedSection] : YAML::Node();
+    if (!c || !c.IsMap() || !c[kInputHashKey])
+      return fmt::format("{} {} has no complete calibrated: section", what, file.string());
+    BondParams b = estimate_bond_params(cfg.ore, cfg.doc);
+    if (read_calibrated_file(file, calibration_hash(cfg), b)) return "";
+    return fmt::format("{} {}: {}", what, file.string(), mismatch(c, cfg));
+  } catch (const std::exception& e) {
+    return fmt::format("{} {}: unreadable ({})", what, file.string(), e.what());
+  }
+}
+}  // namespace
+
+std::string uncalibrated_reason(const config::CaseConfig& cfg, const fs::path& run_dir) {
+  const std::string run =
+      file_reason(run_dir / "calibrate" / "calibrated.yaml", cfg, "calibration");
+  if (run.empty()) return "";
+  const std::string card = file_reason(cfg.ore_file, cfg, "ore card");
+  if (card.empty()) return "";
+  return run + "; " + card;
+}
 
 BondParams bond_params_for(const config::CaseConfig& cfg, const fs::path& run_dir) {
   BondParams b = estimate_bond_params(cfg.ore, cfg.doc);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -21,11 +22,28 @@ std::string ore_hash(const config::Document& ore);
 // fracture_toughness): docs/calibration.md, "The toughness as a target".
 bool fits_toughness(const config::CaseConfig& cfg);
 
+// The lump's material scale, which a calibration holds for and no other:
+// the mean element radius (lump.n_elements in lump.diameter with
+// lump.radius_spread: a bonded packing's strengths and toughness follow it,
+// bench/README.md, "K_IC over the element sizes"), the spread, the bonding
+// range (lump.bond_gap: the coordination), the bond radius multiplier and,
+// for the parallel bond, lump.broken_contact. The JSON map that
+// calibration_hash and calibrated.yaml's `fitted_for` carry.
+nlohmann::json lump_scale(const config::CaseConfig& cfg);
+
 // The input_hash that ties a calibration to what it was fitted to: the
-// card's macro properties (ore_hash), and its fracture_toughness when the
-// fit aimed at it (fits_toughness), so that a section fitted to another
-// K_IC is not taken for this card's.
+// card's macro properties (ore_hash), its fracture_toughness when the fit
+// aimed at it (fits_toughness), so that a section fitted to another K_IC is
+// not taken for this card's, and the lump's scale (lump_scale), so that a
+// section fitted at another element size or bonding range is not either.
 std::string calibration_hash(const config::CaseConfig& cfg);
+
+// Why a run of this case has no calibration (bond_params_for falls back to
+// the closed-form estimate), in one sentence naming the files looked at and,
+// for a card section fitted to another lump scale, what differs; empty when
+// a calibration applies.
+std::string uncalibrated_reason(const config::CaseConfig& cfg,
+                                const std::filesystem::path& run_dir);
 
 // Closed-form starting estimates of the micro parameters (docs/breakage.md),
 // with the case's bond model, its layout and radius multiplier (lump.*).

@@ -10,10 +10,11 @@
 #include "engine/runner.h"
 #include "jobs/job_store.h"
 #include "jobs/output_checks.h"
+#include "lump/material.h"
 #include "postprocess/impact_conditions.h"
 #include "progress.h"
-#include "stages/breakage/calibration_sets.h"
 #include "stages/breakage/breakage_matrix.h"
+#include "stages/breakage/calibration_sets.h"
 #include "stages/breakage/campaign.h"
 #include "stages/breakage/circuit.h"
 #include "stages/breakage/impact_runs.h"
@@ -179,6 +180,12 @@ std::vector<std::string> BreakageStage::jobs_from(const config::CaseConfig& cfg)
 Plan BreakageStage::plan(const StageContext& ctx) const {
   Plan p;
   const nlohmann::json base = impact_base_inputs(ctx);
+  if (const std::string why = uncalibrated_reason(ctx.cfg, ctx.run_dir); !why.empty())
+    p.warnings.push_back(fmt::format(
+        "[breakage] the lumps' bonds are the closed-form estimate, not a calibration of this card "
+        "and lump ({}): a weak rock whose figures mean little; run `orchestrate --case {} --stage "
+        "calibrate-breakage --output {}` first",
+        why, ctx.cfg.file.string(), ctx.run_dir.string()));
   if (ctx.cfg.doc.str("breakage.conditions") != "transport") {
     plan_sweep(ctx, base, p);
   } else {

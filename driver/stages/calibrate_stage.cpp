@@ -36,7 +36,10 @@ using namespace calibrate;
 // its reports carry the levers' sensitivities: a calibration made before has
 // neither. 6: the fit steps all four continuous parameters together on a
 // local linear model (calibrate/local_model.h) instead of one secant each.
-constexpr int kDeckVersion = 6;
+// 7: calibrated.yaml's input_hash covers the lump's scale (lump_scale: element
+// radius, bonding range) and its fitted_for names it: a section written
+// before would no longer be read.
+constexpr int kDeckVersion = 7;
 
 // The fit's targets: the card's four macro properties, and its K_IC when
 // the fit aims at it.

@@ -45,6 +45,9 @@ struct JobSpec {
 struct Plan {
   std::vector<JobSpec> jobs;
   std::string note;
+  // Said as warnings when the stage runs (not in --dry-run, where an
+  // earlier stage of the same command may still change them).
+  std::vector<std::string> warnings;
 };
 
 // Everything a stage may touch while running.

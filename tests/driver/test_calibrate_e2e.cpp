@@ -20,6 +20,7 @@
 #include "config/case_config.h"
 #include "e2e_util.h"
 #include "lump/material.h"
+#include "lump/packing.h"
 
 namespace fs = std::filesystem;
 
@@ -73,7 +74,18 @@ TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
                         "bond_friction_angle", "input_hash"})
     EXPECT_TRUE(y["calibrated"][k]) << k;
   const auto cfg = mill::config::load_case(kData + "/tiny_calibrate.yaml", MILL_PROJECT_DIR);
-  EXPECT_EQ(y["calibrated"]["input_hash"].as<std::string>(), mill::ore_hash(cfg.ore));
+  EXPECT_EQ(y["calibrated"]["input_hash"].as<std::string>(), mill::calibration_hash(cfg));
+  // The lump scale it was fitted for: the element radius the specimen ball
+  // was packed for (the packed ball's own mean scatters around it by 1-2 %).
+  const double radius =
+      mill::target_mean_radius(cfg.doc.integer("lump.n_elements"), cfg.doc.real("lump.diameter"),
+                               cfg.doc.real("lump.radius_spread"));
+  EXPECT_NEAR(y["calibrated"]["fitted_for"]["element_radius_m"].as<double>(), radius,
+              1e-5 * radius);
+  EXPECT_NEAR(y["specimen"]["mean_element_radius_m"].as<double>(), radius, 0.05 * radius);
+  EXPECT_DOUBLE_EQ(y["calibrated"]["fitted_for"]["bond_gap"].as<double>(),
+                   cfg.doc.real("lump.bond_gap"));
+  EXPECT_EQ(mill::uncalibrated_reason(cfg, *dir_), "");
   const mill::BondParams b = mill::bond_params_for(cfg, *dir_);
   EXPECT_NE(b.origin.find("calibrated"), std::string::npos) << b.origin;
   EXPECT_DOUBLE_EQ(b.modulus, y["calibrated"]["bond_modulus"].as<double>());
@@ -344,7 +356,7 @@ TEST(CardCalibration, MatchingCardSectionIsCopiedWithoutFitting) {
   spit(dir / "case.yaml", "name: carded\nore: {card: " + (dir / "carded.yaml").string() +
                               "}\ncalibrate: {n_elements: 100}\nresources: {np: 1, jobs: 1}\n");
   const auto cfg = mill::config::load_case(dir / "case.yaml", MILL_PROJECT_DIR);
-  const std::string hash = mill::ore_hash(cfg.ore);
+  const std::string hash = mill::calibration_hash(cfg);
   spit(dir / "carded.yaml", props +
                                 "calibrated:\n  bond_modulus: 5.5e10\n  stiffness_ratio: 3.9\n"
                                 "  bond_tensile_strength: 1.6e8\n  bond_cohesion: 6.0e7\n"

@@ -1,8 +1,12 @@
-// The input_hash that ties a calibration to its ore card (lump/material.h,
-// calibration_hash): the card's macro properties, and its K_IC when the flat
-// joint's fit aims at it, so that a section fitted to another K_IC is stale.
+// The input_hash that ties a calibration to its ore card and lump
+// (lump/material.h, calibration_hash): the card's macro properties, its K_IC
+// when the flat joint's fit aims at it, so that a section fitted to another
+// K_IC is stale, and the lump's scale (element radius, bonding range), so
+// that a section fitted at another element size is not taken either.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
 #include <filesystem>
 #include <fstream>
@@ -44,15 +48,82 @@ TEST(CalibrationHash, FlatJointToughnessFitHashesTheCardsToughness) {
   ASSERT_TRUE(mill::fits_toughness(a));
   EXPECT_EQ(mill::ore_hash(a.ore), mill::ore_hash(b.ore));  // K_IC is a check key there
   EXPECT_NE(mill::calibration_hash(a), mill::calibration_hash(b));
-  EXPECT_NE(mill::calibration_hash(a), mill::ore_hash(a.ore));
-  // Where K_IC is no target (the parallel bond; the key off) the hash is the card's.
+  // Where K_IC is no target (the parallel bond; the key off) it is not hashed.
   const auto p = with_card(dir / "p", 0.73e6, "{n_elements: 200}"),
              q = with_card(dir / "q", 0.90e6, "{n_elements: 200}");
   EXPECT_FALSE(mill::fits_toughness(p));
-  EXPECT_EQ(mill::calibration_hash(p), mill::ore_hash(p.ore));
   EXPECT_EQ(mill::calibration_hash(p), mill::calibration_hash(q));
-  const auto off = with_card(dir / "off", 0.73e6, fj, "calibrate: {fit_toughness: false}\n");
+  const auto off = with_card(dir / "off", 0.73e6, fj, "calibrate: {fit_toughness: false}\n"),
+             off2 = with_card(dir / "off2", 0.90e6, fj, "calibrate: {fit_toughness: false}\n");
   EXPECT_FALSE(mill::fits_toughness(off));
-  EXPECT_EQ(mill::calibration_hash(off), mill::ore_hash(off.ore));
+  EXPECT_EQ(mill::calibration_hash(off), mill::calibration_hash(off2));
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
+// A bonded packing's strengths and toughness follow its element size and
+// coordination (bench/README.md, "K_IC over the element sizes"): the hash
+// changes with the element radius (element count or diameter), the spread,
+// the bonding range and the broken contacts, and with nothing that leaves
+// them (the packing's seed, the number of packings, the bond slots).
+TEST(CalibrationHash, FollowsTheElementSizeAndBondingRangeOnly) {
+  const fs::path dir = fs::temp_directory_path() / ("mill_cal_scale_" + std::to_string(getpid()));
+  const auto h = [&](const std::string& name, const std::string& lump) {
+    return mill::calibration_hash(with_card(dir / name, 0.73e6, lump));
+  };
+  const std::string base = h("base", "{n_elements: 2000, diameter: 0.04}");
+  EXPECT_NE(base, h("n3344", "{n_elements: 3344, diameter: 0.04}"));
+  EXPECT_NE(base, h("d50", "{n_elements: 2000, diameter: 0.05}"));
+  EXPECT_NE(base, h("gap", "{n_elements: 2000, diameter: 0.04, bond_gap: 0.3}"));
+  EXPECT_NE(base, h("spread", "{n_elements: 2000, diameter: 0.04, radius_spread: 0.2}"));
+  EXPECT_NE(base, h("mult", "{n_elements: 2000, diameter: 0.04, bond_radius_multiplier: 0.8}"));
+  EXPECT_NE(base, h("broken", "{n_elements: 2000, diameter: 0.04, broken_contact: true}"));
+  EXPECT_EQ(base, h("seed", "{n_elements: 2000, diameter: 0.04, seed: 7, n_packings: 3}"));
+  EXPECT_EQ(base, h("slots", "{n_elements: 2000, diameter: 0.04, max_bonds: 24}"));
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
+// A card whose calibrated: section was fitted at another element size is
+// not used for this lump: the run falls back to the closed-form estimate
+// and says why, naming the radius it was fitted at and this lump's.
+TEST(CalibrationHash, CardFittedAtAnotherElementSizeIsNotUsedAndSaysWhy) {
+  const fs::path dir = fs::temp_directory_path() / ("mill_cal_card_" + std::to_string(getpid()));
+  const std::string fj = "{bond_model: flat_joint, bond_gap: 1.0, max_bonds: 32, n_elements: ";
+  const auto at2000 = with_card(dir / "a", 0.73e6, fj + "2000}");
+  // The section as the calibrate stage writes it for the 2000-element lump.
+  YAML::Emitter y;
+  y << YAML::BeginMap;
+  mill::BondParams fitted = mill::estimate_bond_params(at2000.ore, at2000.doc);
+  fitted.tensile = 11.2e6;
+  mill::emit_calibrated(y, fitted, mill::calibration_hash(at2000), mill::lump_scale(at2000));
+  y << YAML::EndMap;
+  std::ifstream in(dir / "a" / "card.yaml");
+  std::stringstream card;
+  card << in.rdbuf();
+  const std::string with_section = card.str() + "\n" + y.c_str() + "\n";
+  const auto write_case = [&](const std::string& name, const std::string& lump) {
+    fs::create_directories(dir / name);
+    std::ofstream(dir / name / "card.yaml") << with_section;
+    std::ofstream(dir / name / "case.yaml")
+        << "name: h\nore: {card: card.yaml}\nlump: " << lump << "\n";
+    return mill::config::load_case(dir / name / "case.yaml", kProject);
+  };
+  const auto same = write_case("same", fj + "2000}");
+  EXPECT_EQ(mill::uncalibrated_reason(same, dir / "same" / "run"), "");
+  EXPECT_DOUBLE_EQ(mill::bond_params_for(same, dir / "same" / "run").tensile, 11.2e6);
+
+  const auto finer = write_case("finer", fj + "3344}");
+  const mill::BondParams b = mill::bond_params_for(finer, dir / "finer" / "run");
+  EXPECT_NE(b.tensile, 11.2e6);
+  EXPECT_NE(b.origin.find("closed-form"), std::string::npos) << b.origin;
+  const std::string why = mill::uncalibrated_reason(finer, dir / "finer" / "run");
+  const auto mm = [](const mill::config::CaseConfig& c) {
+    return fmt::format("{:.6g}", mill::lump_scale(c)["element_radius_m"].get<double>());
+  };
+  EXPECT_NE(why.find("fitted for another lump scale"), std::string::npos) << why;
+  EXPECT_NE(why.find("element_radius_m " + mm(at2000) + " (this case: " + mm(finer) + ")"),
+            std::string::npos)
+      << why;
+  EXPECT_EQ(why.find("bond_gap 1"), std::string::npos) << why;  // the same range: no difference
+  EXPECT_NE(why.find("calibrated.yaml"), std::string::npos) << why;  // the run's file looked at
   if (!HasFailure()) fs::remove_all(dir);
 }

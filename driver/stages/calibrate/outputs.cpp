@@ -67,6 +67,7 @@ class Report {
         wall_(o.wall),
         notes_(o.notes),
         hash_(calibration_hash(cfg)),
+        scale_(lump_scale(cfg)),
         rate_change_(o.half ? post::RelativeError(o.half->r.ucs, b_.ucs.r.ucs) : 0.0),
         rate_ok_(rate_change_ < 0.05),
         noise_(sensitivity_noise(b_.ucs, o.half ? &*o.half : nullptr)),
@@ -99,6 +100,7 @@ class Report {
   const double wall_;
   const std::vector<std::string>& notes_;
   const std::string hash_;
+  const nlohmann::json scale_;  // the lump scale fitted for (calibrated.fitted_for)
   const double rate_change_;
   const bool rate_ok_;
   const Noise noise_;  // run-to-run noise of the sensitivities
@@ -260,6 +262,7 @@ nlohmann::json Report::json() const {
   nlohmann::json report = {
       {"ore", ore_.str("name")},
       {"input_hash", hash_},
+      {"fitted_for", scale_},
       {"source", "fitted"},
       {"targets", targets},
       {"achieved", macro(b_)},
@@ -282,9 +285,8 @@ nlohmann::json Report::json() const {
                                             {"energy", lab_energy_json(half_->energy)},
                                             {"wall_seconds", half_->seconds}}
                            : nlohmann::json(nullptr)},
-      {"sensitivity", o_.sensitivity.empty()
-                          ? nlohmann::json(nullptr)
-                          : sensitivity_json(b_, o_.sensitivity, tol_, noise_)},
+      {"sensitivity", o_.sensitivity.empty() ? nlohmann::json(nullptr)
+                                             : sensitivity_json(b_, o_.sensitivity, tol_, noise_)},
       {"checks", checks_json(o_.checks, b_.ucs.r.ucs)},
       {"energy", energy_summary_json(o_)},
       {"not_reached", missed_},
@@ -299,7 +301,7 @@ std::string Report::yaml() const {
   YAML::Emitter y;
   y.SetDoublePrecision(8);
   y << YAML::BeginMap;
-  emit_calibrated(y, b_.p, hash_);
+  emit_calibrated(y, b_.p, hash_, scale_);
   y << YAML::Key << "ore" << YAML::Value << ore_.str("name");
   y << YAML::Key << "converged" << YAML::Value << b_.converged;
   y << YAML::Key << "targets" << YAML::Value << YAML::BeginMap;
@@ -501,7 +503,7 @@ void copy_from_card(StageContext& ctx, const fs::path& dir) {
   YAML::Emitter y;
   y.SetDoublePrecision(8);
   y << YAML::BeginMap;
-  emit_calibrated(y, read_calibrated(o, BondParams{}), hash);
+  emit_calibrated(y, read_calibrated(o, BondParams{}), hash, lump_scale(ctx.cfg));
   y << YAML::Key << "ore" << YAML::Value << o.str("name") << YAML::Key << "source" << YAML::Value
     << "ore card " + ctx.cfg.ore_file.string() << YAML::EndMap;
   const nlohmann::json report = {
