@@ -12,6 +12,7 @@
 
 #include "config/case_config.h"
 #include "lump/material.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 
@@ -38,7 +39,7 @@ mill::config::CaseConfig with_card(const fs::path& dir, double kic, const std::s
 }  // namespace
 
 TEST(CalibrationHash, FlatJointToughnessFitHashesTheCardsToughness) {
-  const fs::path dir = fs::temp_directory_path() / ("mill_cal_hash_" + std::to_string(getpid()));
+  const mill::test::TempDir dir("mill_cal_hash_" + std::to_string(getpid()));
   const std::string fj = "{bond_model: flat_joint, bond_gap: 1.0, max_bonds: 32}";
   const auto a = with_card(dir / "a", 0.73e6, fj), b = with_card(dir / "b", 0.90e6, fj);
   ASSERT_TRUE(mill::fits_toughness(a));
@@ -54,5 +55,4 @@ TEST(CalibrationHash, FlatJointToughnessFitHashesTheCardsToughness) {
   const auto off = with_card(dir / "off", 0.73e6, fj, "calibrate: {fit_toughness: false}\n");
   EXPECT_FALSE(mill::fits_toughness(off));
   EXPECT_EQ(mill::calibration_hash(off), mill::ore_hash(off.ore));
-  if (!HasFailure()) fs::remove_all(dir);
 }
