@@ -18,22 +18,22 @@
 #include <fstream>
 #include <functional>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
 #include "jobs/job_store.h"
 #include "postprocess/flow_field_io.h"
+#include "temp_dir.h"
 
 namespace mill::e2e {
 
 namespace fs = std::filesystem;
 
-// An empty folder under the temp dir, unique to this process.
-inline fs::path scratch(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("mill_e2e_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
+// An empty folder under the temp dir, unique to this process: removed when
+// the test (or, made in SetUpTestSuite, the suite) passes, kept if it fails.
+inline test::TempDir scratch(const std::string& name) {
+  return test::TempDir("mill_e2e_" + name + "_" + std::to_string(getpid()));
 }
 
 inline std::string slurp(const fs::path& f) {
@@ -91,15 +91,36 @@ inline bool wait_for(const std::function<bool()>& ready, double seconds) {
   return ready();
 }
 
-// Leaves the finished run folder `run` for later tests (CTest fixtures): when
-// $MILL_E2E_KEEP_RUN is set, a symlink of that name points at `run`.
-inline void keep_run(const fs::path& run) {
+// The scratch folder (mill_e2e_*, right under the temp dir) that holds the
+// path `link` points at, a run kept by an earlier keep_run, is removed
+// unless it is `now`'s.
+inline void remove_kept_scratch(const fs::path& link, const test::TempPath& now) {
+  std::error_code ec;
+  if (!fs::is_symlink(link, ec)) return;
+  const fs::path target = fs::read_symlink(link, ec);
+  if (ec) return;
+  const fs::path tmp = fs::temp_directory_path();
+  for (fs::path p = target; p.has_relative_path(); p = p.parent_path()) {
+    if (!fs::equivalent(p.parent_path(), tmp, ec)) continue;
+    if (p.filename().string().rfind("mill_e2e_", 0) == 0 && !fs::equivalent(p, now.path(), ec))
+      fs::remove_all(p, ec);
+    return;
+  }
+}
+
+// Leaves the finished run folder `run`, in the scratch folder `dir`, for
+// later tests (CTest fixtures): when $MILL_E2E_KEEP_RUN is set, a symlink of
+// that name points at `run` and `dir` is kept; the scratch folder of the run
+// the link pointed at before is removed.
+inline void keep_run(const fs::path& run, test::TempPath& dir) {
   const char* keep = std::getenv("MILL_E2E_KEEP_RUN");
   if (!keep || !*keep) return;
   const fs::path link(keep);
   fs::create_directories(link.parent_path());
+  remove_kept_scratch(link, dir);
   fs::remove_all(link);
   fs::create_directory_symlink(fs::absolute(run), link);
+  dir.keep();
 }
 
 // A gas field on the grid over the tiny mill's housing (x -0.4..0.4, y 0..1.2,

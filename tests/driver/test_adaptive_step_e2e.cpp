@@ -40,9 +40,8 @@ std::vector<StepRow> read_steps(const fs::path& file) {
   return rows;
 }
 
-// The case, with breakage.adaptive_step set to `adaptive`, run into its own folder.
-fs::path run_case(bool adaptive) {
-  const fs::path dir = scratch(adaptive ? "adaptive" : "fixed");
+// The case, with breakage.adaptive_step set to `adaptive`, run into the folder `dir`.
+fs::path run_case(const fs::path& dir, bool adaptive) {
   std::string text = slurp(kData + "/tiny_adaptive.yaml");
   if (!adaptive) text.replace(text.find("adaptive_step: true"), 19, "adaptive_step: false");
   spit(dir / "case.yaml", text);
@@ -59,7 +58,8 @@ fs::path run_case(bool adaptive) {
 // interval in simulated time. The fixed run: no step file,
 // and the same breakage within the spread of such a small lump.
 TEST(AdaptiveStep, LedgerClosesAndStepGrowsAfterShattering) {
-  const fs::path adaptive = run_case(true), fixed = run_case(false);
+  const auto adaptive_dir = scratch("adaptive"), fixed_dir = scratch("fixed");
+  const fs::path adaptive = run_case(adaptive_dir, true), fixed = run_case(fixed_dir, false);
   const auto ra = nlohmann::json::parse(slurp(adaptive / "result.json"));
   const auto rf = nlohmann::json::parse(slurp(fixed / "result.json"));
   const double res_a = ra.at("energy").at("residual_fraction").get<double>();

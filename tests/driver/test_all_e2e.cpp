@@ -41,7 +41,7 @@ std::vector<std::string> breakage_jobs(const fs::path& run, State s) {
 }
 
 TEST(WholeWorkflow, StageAllKilledMidBreakageResumesWithoutRedoingJobs) {
-  const fs::path dir = scratch("all");
+  auto dir = scratch("all");
   const fs::path run = dir / "runs" / "tiny_all";  // the default, relative run folder
   const std::vector<std::string> args = {"--case", std::string(MILL_TEST_DATA) + "/tiny_all.yaml", "--stage", "all"};
 
@@ -195,7 +195,7 @@ TEST(WholeWorkflow, StageAllKilledMidBreakageResumesWithoutRedoingJobs) {
       << headline;
   EXPECT_NE(headline.find(sentence), std::string::npos) << sentence;
   EXPECT_EQ(h.at("circuit_decision").at("sentence"), sentence);
-  keep_run(run);  // a finished run for e2e.compare and report.browser
+  keep_run(run, dir);  // a finished run for e2e.compare and report.browser
 }
 
 }  // namespace

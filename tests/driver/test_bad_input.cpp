@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "temp_dir.h"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -90,9 +92,8 @@ class BadInput : public ::testing::TestWithParam<Case> {};
 TEST_P(BadInput, ExitStatusAndMessage) {
   const Case& c = GetParam();
   ASSERT_NE(c.exit_status, -1000) << "manifest.txt:" << c.line << ": expected 5 fields separated by '|'";
-  const fs::path tmp = fs::temp_directory_path() / ("mill_bad_input_" + std::to_string(getpid())) / c.name;
-  fs::remove_all(tmp);
-  fs::create_directories(tmp);
+  // Removed, with its parent folder once empty, when the case passes.
+  const mill::test::TempDir tmp(fs::path("mill_bad_input_" + std::to_string(getpid())) / c.name);
   auto subst = [&](const std::string& s) {
     return replace_all(replace_all(replace_all(s, "@DATA@", MILL_BAD_INPUT_DIR), "@TMP@", tmp.string()), "@PROJECT@",
                        MILL_PROJECT_DIR);
@@ -115,9 +116,9 @@ TEST_P(BadInput, ExitStatusAndMessage) {
   // a value printed unreadably (e.g. a CLI bound of 1.8e308 written out).
   const std::regex long_number("[0-9]{20,}");
   for (auto it = std::sregex_iterator(text.begin(), text.end(), long_number); it != std::sregex_iterator(); ++it)
-    EXPECT_NE(args.find(it->str()), std::string::npos) << c.name << ": unreadable number " << it->str() << " in:\n"
-                                                       << text;
-  if (!HasFailure()) fs::remove_all(tmp);
+    EXPECT_NE(args.find(it->str()), std::string::npos)
+        << c.name << ": unreadable number " << it->str() << " in:\n"
+        << text;
 }
 
 INSTANTIATE_TEST_SUITE_P(Corpus, BadInput, ::testing::ValuesIn(load_manifest()),

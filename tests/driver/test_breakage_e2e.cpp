@@ -21,15 +21,15 @@ const std::string kData = MILL_TEST_DATA;
 class TinyCampaign : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new fs::path(scratch("campaign"));
+    dir_ = new mill::test::TempDir(scratch("campaign"));
     status_ = orchestrate("--case " + kData + "/tiny_breakage.yaml --stage breakage --output " + dir_->string(),
                           *dir_ / "first.log");
   }
-  static void TearDownTestSuite() { delete dir_; }
-  static fs::path* dir_;
+  static void TearDownTestSuite() { delete dir_; }  // removed if every test passed
+  static mill::test::TempDir* dir_;
   static int status_;
 };
-fs::path* TinyCampaign::dir_ = nullptr;
+mill::test::TempDir* TinyCampaign::dir_ = nullptr;
 int TinyCampaign::status_ = -1;
 
 TEST_F(TinyCampaign, RunsAndWritesEveryOutput) {
@@ -144,7 +144,7 @@ TEST_F(TinyCampaign, RerunSkipsDoneJobs) {
 // SIGTERM mid-campaign: finished jobs stay done, the running one is marked
 // failed (never done), and a rerun completes without redoing finished jobs.
 TEST(KillResume, KilledCampaignResumes) {
-  const fs::path dir = scratch("kill");
+  const auto dir = scratch("kill");
   const std::vector<std::string> args = {"--case", kData + "/tiny_breakage.yaml", "--stage", "breakage", "--jobs", "1",
                                          "--output", dir.string()};
   const pid_t pid = spawn_orchestrate(args, dir / "killed.log");
@@ -170,7 +170,7 @@ TEST(KillResume, KilledCampaignResumes) {
 }
 
 TEST(ImpactCommand, WritesOneRowInItsFolder) {
-  const fs::path dir = scratch("impact");
+  const auto dir = scratch("impact");
   const int st = orchestrate("impact --velocity 2 --elements 120 --output " + dir.string(), dir / "impact.log");
   ASSERT_EQ(st, 0) << slurp(dir / "impact.log");
   const auto rows = mill::post::ReadSummaryCsv((dir / "summary.csv").string());
@@ -199,7 +199,7 @@ TEST_F(TinyCampaign, ReportEmbedsTheBreakageResults) {
   // The headline says it in words: the critical speed at 90 degrees.
   EXPECT_NE(html.find("critical impact speed (largest piece &lt; 5%), 90 deg"), std::string::npos);
   EXPECT_NE(html.find("breakage/plots/passing_vs_size.png"), std::string::npos);
-  keep_run(*dir_);  // a finished run for e2e.compare
+  keep_run(*dir_, *dir_);  // a finished run for e2e.compare
 }
 
 }  // namespace
@@ -209,7 +209,7 @@ namespace {
 // Conditions from a (hand-made) transport result: two bins, weights 3:1,
 // and the mill product is their weighted size distribution.
 TEST(MillProduct, ConditionsFromTransportImpacts) {
-  const fs::path dir = scratch("product");
+  const auto dir = scratch("product");
   fs::create_directories(dir / "transport/rpm2000");
   std::ofstream(dir / "transport/rpm2000/impacts.csv")
       << "time_s,particle_id,surface,x_m,y_m,z_m,speed_m_s,normal_speed_m_s,tangential_speed_m_s,angle_deg\n"

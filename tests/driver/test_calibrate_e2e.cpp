@@ -37,16 +37,16 @@ nlohmann::json read_json(const fs::path& f) { return nlohmann::json::parse(slurp
 class TinyCalibration : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new fs::path(scratch("tiny"));
+    dir_ = new mill::test::TempDir(scratch("tiny"));
     status_ = orchestrate(
         "--case " + kData + "/tiny_calibrate.yaml --stage calibrate --output " + dir_->string(),
         *dir_ / "first.log");
   }
-  static void TearDownTestSuite() { delete dir_; }
-  static fs::path* dir_;
+  static void TearDownTestSuite() { delete dir_; }  // removed if every test passed
+  static mill::test::TempDir* dir_;
   static int status_;
 };
-fs::path* TinyCalibration::dir_ = nullptr;
+mill::test::TempDir* TinyCalibration::dir_ = nullptr;
 int TinyCalibration::status_ = -1;
 
 TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
@@ -253,7 +253,7 @@ nlohmann::json without_times(const nlohmann::json& j, const std::string& run) {
 // and the tests did overlap.
 TEST_F(TinyCalibration, TwoLanesGiveTheSameCalibrationWithTestsSideBySide) {
   ASSERT_EQ(status_, 0) << slurp(*dir_ / "first.log");
-  const fs::path two = scratch("tiny_lanes");
+  const auto two = scratch("tiny_lanes");
   ASSERT_EQ(orchestrate("--case " + kData + "/tiny_calibrate.yaml --stage calibrate --jobs 2 --output " +
                             two.string(),
                         two / "log"),
@@ -303,7 +303,7 @@ std::string tiny_case(const fs::path& card_file, int iterations) {
 // elements, so P* is chosen to give E close to the card's E in the measuring run.)
 TEST(SyntheticTarget, FitRecoversPerturbedBondModulusAndStrengths) {
   const double Eb = 16.6e9, ratio = 2.5, sigma_b = 10e6, c = 20e6;
-  const fs::path dir = scratch("synthetic");
+  const auto dir = scratch("synthetic");
   // Measure with P*: twice, the second time with the card's E (the contact
   // modulus) set to the E measured the first time.
   double E_card = 6.4e9;
@@ -348,7 +348,7 @@ TEST(SyntheticTarget, FitRecoversPerturbedBondModulusAndStrengths) {
 // A card whose calibrated.* section was fitted to its own properties: the
 // stage copies it and runs no lab test.
 TEST(CardCalibration, MatchingCardSectionIsCopiedWithoutFitting) {
-  const fs::path dir = scratch("card");
+  const auto dir = scratch("card");
   const std::string props =
       "name: carded\ndensity: 2580\nyoungs_modulus: 18.69e9\npoisson_ratio: 0.18\nucs: 50.0e6\n"
       "tensile_strength: 5.0e6\n";

@@ -11,6 +11,7 @@
 
 #include "stages/calibrate/energy_report.h"
 #include "stages/stage_util.h"
+#include "temp_dir.h"
 
 using namespace mill;
 using namespace mill::calibrate;
@@ -157,10 +158,7 @@ TEST(CalibrateEnergy, MarkdownSectionHasEveryRunAndTheWorst) {
 // A run folder without ledger.csv, or with one that does not parse: the error
 // names the file.
 TEST(CalibrateEnergy, MissingOrBadLedgerNamesTheFile) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
-                                    ("mill_calibrate_energy_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const mill::test::TempDir dir("mill_calibrate_energy_" + std::to_string(::getpid()));
   const std::string file = (dir / "ledger.csv").string();
   try {
     read_run_ledger(dir);
@@ -176,5 +174,4 @@ TEST(CalibrateEnergy, MissingOrBadLedgerNamesTheFile) {
     EXPECT_NE(std::string(e.what()).find(file + ":1: header lacks column"), std::string::npos)
         << e.what();
   }
-  std::filesystem::remove_all(dir);
 }

@@ -16,6 +16,7 @@
 
 #include "config/case_config.h"
 #include "lump/material.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 
@@ -42,7 +43,7 @@ mill::config::CaseConfig with_card(const fs::path& dir, double kic, const std::s
 }  // namespace
 
 TEST(CalibrationHash, FlatJointToughnessFitHashesTheCardsToughness) {
-  const fs::path dir = fs::temp_directory_path() / ("mill_cal_hash_" + std::to_string(getpid()));
+  const mill::test::TempDir dir("mill_cal_hash_" + std::to_string(getpid()));
   const std::string fj = "{bond_model: flat_joint, bond_gap: 1.0, max_bonds: 32}";
   const auto a = with_card(dir / "a", 0.73e6, fj), b = with_card(dir / "b", 0.90e6, fj);
   ASSERT_TRUE(mill::fits_toughness(a));
@@ -57,7 +58,6 @@ TEST(CalibrationHash, FlatJointToughnessFitHashesTheCardsToughness) {
              off2 = with_card(dir / "off2", 0.90e6, fj, "calibrate: {fit_toughness: false}\n");
   EXPECT_FALSE(mill::fits_toughness(off));
   EXPECT_EQ(mill::calibration_hash(off), mill::calibration_hash(off2));
-  if (!HasFailure()) fs::remove_all(dir);
 }
 
 // A bonded packing's strengths and toughness follow its element size and
@@ -66,7 +66,7 @@ TEST(CalibrationHash, FlatJointToughnessFitHashesTheCardsToughness) {
 // the bonding range and the broken contacts, and with nothing that leaves
 // them (the packing's seed, the number of packings, the bond slots).
 TEST(CalibrationHash, FollowsTheElementSizeAndBondingRangeOnly) {
-  const fs::path dir = fs::temp_directory_path() / ("mill_cal_scale_" + std::to_string(getpid()));
+  const mill::test::TempDir dir("mill_cal_scale_" + std::to_string(getpid()));
   const auto h = [&](const std::string& name, const std::string& lump) {
     return mill::calibration_hash(with_card(dir / name, 0.73e6, lump));
   };
@@ -79,14 +79,13 @@ TEST(CalibrationHash, FollowsTheElementSizeAndBondingRangeOnly) {
   EXPECT_NE(base, h("broken", "{n_elements: 2000, diameter: 0.04, broken_contact: true}"));
   EXPECT_EQ(base, h("seed", "{n_elements: 2000, diameter: 0.04, seed: 7, n_packings: 3}"));
   EXPECT_EQ(base, h("slots", "{n_elements: 2000, diameter: 0.04, max_bonds: 24}"));
-  if (!HasFailure()) fs::remove_all(dir);
 }
 
 // A card whose calibrated: section was fitted at another element size is
 // not used for this lump: the run falls back to the closed-form estimate
 // and says why, naming the radius it was fitted at and this lump's.
 TEST(CalibrationHash, CardFittedAtAnotherElementSizeIsNotUsedAndSaysWhy) {
-  const fs::path dir = fs::temp_directory_path() / ("mill_cal_card_" + std::to_string(getpid()));
+  const mill::test::TempDir dir("mill_cal_card_" + std::to_string(getpid()));
   const std::string fj = "{bond_model: flat_joint, bond_gap: 1.0, max_bonds: 32, n_elements: ";
   const auto at2000 = with_card(dir / "a", 0.73e6, fj + "2000}");
   // The section as the calibrate stage writes it for the 2000-element lump.
@@ -125,5 +124,4 @@ TEST(CalibrationHash, CardFittedAtAnotherElementSizeIsNotUsedAndSaysWhy) {
       << why;
   EXPECT_EQ(why.find("bond_gap 1"), std::string::npos) << why;  // the same range: no difference
   EXPECT_NE(why.find("calibrated.yaml"), std::string::npos) << why;  // the run's file looked at
-  if (!HasFailure()) fs::remove_all(dir);
 }

@@ -5,13 +5,14 @@
 
 #include <algorithm>
 #include <array>
-#include <fstream>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include "jobs/job_store.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 
@@ -23,12 +24,9 @@ struct Out {
 };
 
 // Run orchestrate with arguments in a scratch folder; capture output and status.
+// The folder is this process's, removed at its end when every test passed.
 Out orchestrate(const std::string& args) {
-  static const fs::path cwd = [] {
-    fs::path d = fs::temp_directory_path() / ("mill_cli_" + std::to_string(getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
+  static const mill::test::TempDir cwd("mill_cli_" + std::to_string(getpid()));
   const std::string cmd = "cd '" + cwd.string() + "' && '" + std::string(ORCHESTRATE_EXE) + "' " + args + " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   std::string text;
@@ -146,8 +144,7 @@ TEST(Cli, PrintSchema) {
 namespace {
 
 TEST(Cli, HpcWritesArrayAndMergeScripts) {
-  const fs::path out = fs::temp_directory_path() / ("mill_cli_hpc_" + std::to_string(getpid()));
-  fs::remove_all(out);
+  const mill::test::TempPath out("mill_cli_hpc_" + std::to_string(getpid()));
   auto o = orchestrate("hpc --scheduler slurm --stage breakage --case " + kData + "/good_small.yaml --np 2 --output " +
                        out.string());
   ASSERT_EQ(o.status, 0) << o.text;
@@ -163,8 +160,7 @@ TEST(Cli, HpcWritesArrayAndMergeScripts) {
 }
 
 TEST(Cli, HpcStageAllWritesTheChainWithAPlannedBreakage) {
-  const fs::path out = fs::temp_directory_path() / ("mill_cli_hpc_all_" + std::to_string(getpid()));
-  fs::remove_all(out);
+  const mill::test::TempPath out("mill_cli_hpc_all_" + std::to_string(getpid()));
   auto o = orchestrate("hpc --scheduler slurm --stage all --case " + kData + "/tiny_hpc.yaml --output " + out.string());
   ASSERT_EQ(o.status, 0) << o.text;
   EXPECT_NE(o.text.find("array sized by a planning job"), std::string::npos) << o.text;
@@ -179,8 +175,7 @@ TEST(Cli, HpcStageAllWritesTheChainWithAPlannedBreakage) {
 }
 
 TEST(Cli, MergeOnlyNamesTheJobsNotDoneWithTheirSchedulerJob) {
-  const fs::path out = fs::temp_directory_path() / ("mill_cli_merge_" + std::to_string(getpid()));
-  fs::remove_all(out);
+  const mill::test::TempPath out("mill_cli_merge_" + std::to_string(getpid()));
   const std::string args = "--case " + kData + "/good_small.yaml --output " + out.string() + " --stage breakage";
   // Task 0 failed under a scheduler; the others never started.
   const std::string list = orchestrate(args + " --list-tasks").text;
@@ -209,8 +204,7 @@ TEST(Cli, HpcRejectsUnknownScheduler) {
 // Valid Slurm values go into the #SBATCH lines as given; a run folder with
 // blanks is quoted there (sbatch splits #SBATCH lines on blanks).
 TEST(Cli, HpcWritesCheckedValuesAndQuotesPaths) {
-  const fs::path out = fs::temp_directory_path() / ("mill cli hpc spaces " + std::to_string(getpid()));
-  fs::remove_all(out);
+  const mill::test::TempPath out("mill cli hpc spaces " + std::to_string(getpid()));
   auto o = orchestrate("hpc --stage breakage --case " + kData + "/good_small.yaml --time 1-12:30 --mem 4G --partition "
                        "gpu,short --account proj_1 --max-parallel 2 --output '" + out.string() + "'");
   ASSERT_EQ(o.status, 0) << o.text;
@@ -220,7 +214,6 @@ TEST(Cli, HpcWritesCheckedValuesAndQuotesPaths) {
                                  "#SBATCH --account=proj_1\n", "#SBATCH --array=0-3%2\n",
                                  "#SBATCH --output=\"" + (out / "hpc" / "logs").string() + "/%x_%A_%a.out\"\n"})
     EXPECT_NE(array.find(line), std::string::npos) << line << " not in:\n" << array;
-  fs::remove_all(out);
 }
 
 }  // namespace

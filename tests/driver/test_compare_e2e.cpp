@@ -25,7 +25,7 @@ TEST(Compare, TwoFinishedRunsSideBySide) {
   const fs::path all = runs() / "tiny_all", sweep = runs() / "tiny_breakage";
   ASSERT_TRUE(fs::exists(all / "report/summary.json")) << "run e2e.stage_all first (CTest fixture): " << all;
   ASSERT_TRUE(fs::exists(sweep / "report/summary.json")) << "run e2e.breakage first (CTest fixture): " << sweep;
-  const fs::path dir = scratch("compare");
+  const auto dir = scratch("compare");
   const fs::path out = dir / "cmp";
   ASSERT_EQ(orchestrate("compare '" + all.string() + "' '" + sweep.string() + "' --output '" + out.string() + "'",
                         dir / "compare.log"),
@@ -67,7 +67,7 @@ TEST(Compare, TwoFinishedRunsSideBySide) {
 
 TEST(Compare, AFolderThatIsNotAFinishedRunIsANamedError) {
   const fs::path all = runs() / "tiny_all";
-  const fs::path dir = scratch("compare_bad");
+  const auto dir = scratch("compare_bad");
   fs::create_directories(dir / "half_done/breakage");  // a run whose report never ran
   EXPECT_EQ(orchestrate("compare '" + all.string() + "' '" + (dir / "half_done").string() + "' --output '" +
                             (dir / "o").string() + "'",

@@ -1,11 +1,13 @@
 // Case-file and ore-card validation: every bad file names its key and line.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <fstream>
 
 #include "config/case_config.h"
 #include "config/schema.h"
 #include "stages/breakage/lump_run.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using mill::config::ConfigError;
@@ -120,14 +122,12 @@ TEST(CaseFile, BundledCasesAreValid) {
 // A calibration pasted into the card keeps a moment factor of 0 (what the
 // UCS/tensile lever sets): the card must accept it, as calibrated.yaml does.
 TEST(OreCard, CalibratedMomentFactorZeroIsValid) {
-  const fs::path dir = fs::temp_directory_path() / "mill_card_beta0";
-  fs::create_directories(dir);
+  const mill::test::TempDir dir("mill_card_beta0_" + std::to_string(getpid()));
   std::ofstream(dir / "card.yaml") << "name: r\ndensity: 2580\nyoungs_modulus: 18.69e9\n"
                                       "poisson_ratio: 0.18\nucs: 50.0e6\ntensile_strength: 5.0e6\n"
                                       "calibrated:\n  bond_moment_factor: 0\n";
   const auto ore = mill::config::Document::load(dir / "card.yaml", mill::config::ore_schema());
   EXPECT_EQ(ore.real("calibrated.bond_moment_factor"), 0.0);
-  fs::remove_all(dir);
 }
 
 // A deliberate outlier: the card lists the keys in allow_outside_range; the
@@ -258,8 +258,7 @@ TEST(EditDistance, Basics) {
 // asks for both is refused (tests/bad_input/adaptive_step_with_timestep.yaml),
 // and `false` turns it off.
 TEST(CaseFile, AdaptiveStepIsTheDefaultWithTheAutomaticStep) {
-  const fs::path dir = fs::temp_directory_path() / "mill_adaptive_default";
-  fs::create_directories(dir);
+  const mill::test::TempDir dir("mill_adaptive_default_" + std::to_string(getpid()));
   struct {
     const char *text;
     bool on;
@@ -273,5 +272,4 @@ TEST(CaseFile, AdaptiveStepIsTheDefaultWithTheAutomaticStep) {
     const auto cfg = load_case(f, kProject);
     EXPECT_EQ(mill::breakage::adaptive_step_on(cfg.doc), c.on) << c.text;
   }
-  fs::remove_all(dir);
 }

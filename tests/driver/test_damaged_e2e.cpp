@@ -24,11 +24,11 @@ const std::string kCase = std::string(MILL_TEST_DATA) + "/tiny_damaged.yaml";
 class DamagedRun : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new fs::path(scratch("damaged"));
+    dir_ = new mill::test::TempDir(scratch("damaged"));
     status_ = run("breakage", "first.log");
     if (status_ == 0) status_ = run("report", "first_report.log");
   }
-  static void TearDownTestSuite() { delete dir_; }
+  static void TearDownTestSuite() { delete dir_; }  // removed if every test passed
   // orchestrate --stage <stage> on the run folder; the log is kept in `log`.
   static int run(const std::string& stage, const std::string& log) {
     return orchestrate("--case " + kCase + " --stage " + stage + " --output " + dir_->string(), *dir_ / log);
@@ -58,10 +58,10 @@ class DamagedRun : public ::testing::Test {
       html.erase(at + key.size(), html.find('"', at + key.size()) - at - key.size());
     return html;
   }
-  static fs::path* dir_;
+  static mill::test::TempDir* dir_;
   static int status_;
 };
-fs::path* DamagedRun::dir_ = nullptr;
+mill::test::TempDir* DamagedRun::dir_ = nullptr;
 int DamagedRun::status_ = -1;
 
 TEST_F(DamagedRun, FinishedRunIsSound) {
@@ -182,7 +182,7 @@ TEST_F(DamagedRun, RunFolderRefusesAnotherCase) {
 }
 
 TEST(ImpactRerun, IdenticalImpactIsNotRedone) {
-  const fs::path dir = scratch("impact_rerun");
+  const auto dir = scratch("impact_rerun");
   const std::string args = "impact --velocity 20 --elements 50 --output " + (dir / "out").string();
   ASSERT_EQ(orchestrate(args, dir / "first.log"), 0) << slurp(dir / "first.log");
   const auto t0 = fs::last_write_time(dir / "out/result.json");

@@ -57,7 +57,7 @@ void write_transport_impacts(const fs::path& run) {
 class Feed : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new fs::path(scratch("feed"));
+    dir_ = new mill::test::TempDir(scratch("feed"));
     write_transport_impacts(*dir_);
     // A scripted flow report at 2000 rpm: the gas takes 30 kW at the shaft.
     fs::create_directories(*dir_ / "flow/rpm2000");
@@ -70,13 +70,13 @@ class Feed : public ::testing::Test {
     // this scripted flow lacks.
     fs::remove_all(*dir_ / "flow");
   }
-  static void TearDownTestSuite() { delete dir_; }
-  static fs::path* dir_;
+  static void TearDownTestSuite() { delete dir_; }  // removed if every test passed
+  static mill::test::TempDir* dir_;
   static int status_;
   fs::path stage() const { return *dir_ / "breakage"; }
   json read(const std::string& f) const { return json::parse(slurp(stage() / f)); }
 };
-fs::path* Feed::dir_ = nullptr;
+mill::test::TempDir* Feed::dir_ = nullptr;
 int Feed::status_ = -1;
 
 TEST_F(Feed, BreakageMatrixPerRotorSpeedFromEachClassesOwnInMillPieces) {

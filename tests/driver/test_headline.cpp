@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "report/headline.h"
+#include "temp_dir.h"
 
 namespace {
 
@@ -63,8 +64,7 @@ TEST(Headline, SaysItInWordsAndUnitsWithTheSpread) {
 // backflow; without them there is no power line.
 TEST(Headline, ShaftPowerFromTheFlowReportWhenItHasIt) {
   namespace fs = std::filesystem;
-  const fs::path run = fs::temp_directory_path() / ("mill_headline_" + std::to_string(getpid()));
-  fs::remove_all(run);
+  const mill::test::TempDir run("mill_headline_" + std::to_string(getpid()));
   fs::create_directories(run / "flow/rpm1500");
   fs::create_directories(run / "flow/rpm2000");
   std::ofstream(run / "flow/rpm1500/flow_report.json")
@@ -88,15 +88,13 @@ TEST(Headline, ShaftPowerFromTheFlowReportWhenItHasIt) {
   EXPECT_EQ(value_of(rows, "flywheel shaft power (gas only), 2000 rpm"), "");
   EXPECT_EQ(value_of(rows, "flow solution, 2000 rpm"), "not converged after 30 iterations");
   EXPECT_TRUE(headline_rows(json::object()).empty());
-  fs::remove_all(run);
 }
 
 // The comminution efficiency from breakage/comminution_efficiency.json: at
 // the critical speed with its range over the sweep, or why there is none.
 TEST(Headline, ComminutionEfficiencyAtTheCriticalSpeed) {
   namespace fs = std::filesystem;
-  const fs::path run = fs::temp_directory_path() / ("mill_headline_eff_" + std::to_string(getpid()));
-  fs::remove_all(run);
+  const mill::test::TempDir run("mill_headline_eff_" + std::to_string(getpid()));
   fs::create_directories(run / "breakage");
   std::ofstream(run / "breakage/comminution_efficiency.json")
       << R"([{"angle_deg": 90, "critical_velocity_m_s": 66.2, "impacts": 8, "at_critical_speed": 0.01234,
@@ -117,7 +115,6 @@ TEST(Headline, ComminutionEfficiencyAtTheCriticalSpeed) {
     EXPECT_EQ(r.group, "Breakage of one lump (stage 2)") << r.what;
     EXPECT_EQ(r.brief, r.what.rfind("comminution", 0) == 0) << r.what;
   }
-  fs::remove_all(run);
 }
 
 TEST(Headline, NoJkFitSaysWhy) {
@@ -130,8 +127,7 @@ TEST(Headline, NoJkFitSaysWhy) {
 // housing impact that follows, from summary.json through headline_json.
 TEST(Headline, LumpsLeavingTheBeatersAndTheirNextHousingImpact) {
   namespace fs = std::filesystem;
-  const fs::path run = fs::temp_directory_path() / ("mill_headline_tr_" + std::to_string(getpid()));
-  fs::remove_all(run);
+  const mill::test::TempDir run("mill_headline_tr_" + std::to_string(getpid()));
   fs::create_directories(run / "transport/rpm2000");
   std::ofstream(run / "transport/rpm2000/summary.json")
       << R"({"n_particles": 360, "n_flywheel_impacts": 512, "n_wall_impacts": 2011,
@@ -149,7 +145,6 @@ TEST(Headline, LumpsLeavingTheBeatersAndTheirNextHousingImpact) {
             "112 m/s ± 30 (sd), 42 deg to the wall, 12.3 ms after leaving the beater");
   EXPECT_EQ(value_of(rows, "sliding contacts (left out of the impact figures), 2000 rpm"),
             "1403 below 1 m/s normal speed");
-  fs::remove_all(run);
 }
 
 }  // namespace
@@ -217,9 +212,7 @@ namespace {
 // and the decision's sentence, kWh/t and band from breakage/circuit.json.
 TEST(Headline, ClosedCircuitEnergyAndDecisionWithItsKWhPerTonne) {
   namespace fs = std::filesystem;
-  const fs::path run =
-      fs::temp_directory_path() / ("mill_headline_circuit_" + std::to_string(getpid()));
-  fs::remove_all(run);
+  const mill::test::TempDir run("mill_headline_circuit_" + std::to_string(getpid()));
   fs::create_directories(run / "breakage");
   std::ofstream(run / "breakage/circuit.json") << R"({"sieves_mm": [2, 4, 8],
       "rotor_speeds": [{"rpm": 2000, "steady": true, "p50_mm": 3.1, "p80_mm": 6.2, "circulating_load": 0.8,
@@ -242,7 +235,6 @@ TEST(Headline, ClosedCircuitEnergyAndDecisionWithItsKWhPerTonne) {
             "class: no band");
   EXPECT_EQ(value_of(rows, "energy per tonne of feed, 2000 rpm"),
             "2.75 kWh/t (gas shaft 30 kW + ore 25 kW, 1.8 passes per tonne)");
-  fs::remove_all(run);
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "config/case_config.h"
 #include "hpc.h"
 #include "pipeline.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using mill::HpcOptions;
@@ -25,11 +26,9 @@ namespace {
 const fs::path kData = MILL_TEST_DATA;
 const fs::path kProject = MILL_PROJECT_DIR;
 
-fs::path fresh_dir(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("mill_hpc_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
+// An empty folder, removed when the test passes.
+mill::test::TempDir fresh_dir(const std::string& name) {
+  return mill::test::TempDir("mill_hpc_" + name + "_" + std::to_string(getpid()));
 }
 
 std::string slurp(const fs::path& f) {
@@ -97,7 +96,7 @@ TEST(HpcStages, RangesExpandInPipelineOrder) {
 }
 
 TEST(HpcScripts, WholeChainHasOneScriptPerStageAndAPlannedBreakageArray) {
-  const fs::path out = fresh_dir("all");
+  const auto out = fresh_dir("all");
   std::set<std::string> asked;
   const auto count = [&](const std::string& s) {
     asked.insert(s);
@@ -177,7 +176,7 @@ struct FakeSlurm {
 };
 
 TEST(HpcScripts, SubmitChainsStagesWithAfterokAndThePlanningJobSubmitsTheRest) {
-  const fs::path out = fresh_dir("chain");
+  const auto out = fresh_dir("chain");
   // A stand-in orchestrate whose breakage plan has three jobs.
   write_exe(out / "orchestrate",
             "#!/bin/sh\n"
@@ -254,7 +253,7 @@ TEST(HpcScripts, SubmitChainsStagesWithAfterokAndThePlanningJobSubmitsTheRest) {
 }
 
 TEST(HpcScripts, SubmitStopsWhenSbatchFails) {
-  const fs::path out = fresh_dir("sbatch_fails");
+  const auto out = fresh_dir("sbatch_fails");
   mill::write_hpc_scripts(
       tiny(), options("all", out / "run"), [](const std::string&) { return 1; }, "/bin/false");
   fs::create_directories(out / "bin");
@@ -268,7 +267,7 @@ TEST(HpcScripts, SubmitStopsWhenSbatchFails) {
 }
 
 TEST(HpcScripts, BreakageAfterADoneTransportHasItsArraySizeNow) {
-  const fs::path out = fresh_dir("known");
+  const auto out = fresh_dir("known");
   const std::string text = mill::write_hpc_scripts(
       tiny(), options("breakage-report", out), [](const std::string&) { return 5; }, "/bin/true");
   const fs::path h = out / "hpc";
@@ -346,7 +345,7 @@ TEST(HpcDirective, QuotesBlanksAndRejectsLineBreaks) {
 }
 
 TEST(HpcScripts, OptionValuesAreCheckedBeforeAnyScriptIsWritten) {
-  const fs::path out = fresh_dir("bad_option");
+  const auto out = fresh_dir("bad_option");
   HpcOptions o = options("all", out);
   o.account = "proj\nx";
   try {
@@ -365,7 +364,8 @@ TEST(HpcScripts, OptionValuesAreCheckedBeforeAnyScriptIsWritten) {
 }
 
 TEST(HpcScripts, RunFolderWithBlanksIsQuoted) {
-  const fs::path out = fresh_dir("blank") / "my run";
+  const auto dir = fresh_dir("blank");
+  const fs::path out = dir / "my run";
   mill::write_hpc_scripts(
       tiny(), options("flow", out), [](const std::string&) { return 1; },
       "/opt/my mill/orchestrate");

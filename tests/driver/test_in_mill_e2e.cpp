@@ -108,7 +108,7 @@ double data_file_mass(const fs::path& f) {
 }
 
 TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAKill) {
-  const fs::path dir = scratch("in_mill");
+  const auto dir = scratch("in_mill");
   write_transport_impacts(dir);
   const std::string yaml = kData + "/tiny_in_mill.yaml";
   ASSERT_EQ(
@@ -307,7 +307,7 @@ TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAK
 // breakage.in_mill.animate: false: no run writes frames, and every in-mill
 // job keeps the id it has with the animation on, but the animated one.
 TEST(InMill, AnimationOffWritesNoFramesAndKeepsTheOtherJobIds) {
-  const fs::path dir = scratch("in_mill_no_animation");
+  const auto dir = scratch("in_mill_no_animation");
   write_transport_impacts(dir);
   std::string yaml = slurp(kData + "/tiny_in_mill.yaml");
   const std::string from = "gas: false}";
@@ -350,7 +350,7 @@ TEST(InMill, AnimationOffWritesNoFramesAndKeepsTheOtherJobIds) {
 // against 35.7), the one the beater cannot reach. With the early stop off
 // it runs its whole 4 ms, and its record says so.
 TEST(InMill, GasDragFromTheSampledField) {
-  const fs::path dir = scratch("in_mill_gas");
+  const auto dir = scratch("in_mill_gas");
   write_transport_impacts(dir);
   mill::post::FlowField f = tiny_housing_field(2000, "synthetic: still air (test_in_mill_e2e)");
   for (size_t p = 0; p < f.mask.size(); ++p) {
@@ -385,7 +385,7 @@ TEST(InMill, GasDragFromTheSampledField) {
 
 // With gas but no sampled field the in-mill run fails and says what makes it.
 TEST(InMill, MissingFieldNamesFileCommandAndKey) {
-  const fs::path dir = scratch("in_mill_nofield");
+  const auto dir = scratch("in_mill_nofield");
   write_transport_impacts(dir);
   std::string yaml = slurp(kData + "/tiny_in_mill.yaml");
   const std::string from = "gas: false}";

@@ -9,17 +9,16 @@
 #include <thread>
 
 #include "jobs/job_store.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace mill::jobs;
 
 namespace {
 
-fs::path fresh_dir(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("mill_test_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
+// An empty folder, removed when the test passes.
+mill::test::TempDir fresh_dir(const std::string& name) {
+  return mill::test::TempDir("mill_test_" + name + "_" + std::to_string(getpid()));
 }
 
 const nlohmann::json kIn = {{"velocity", 150.0}, {"angle", 90.0}};
@@ -32,7 +31,8 @@ TEST(JobId, DependsOnInputsOnlyCanonically) {
 }
 
 TEST(JobStore, SchedulerJobAndLogStayInStatus) {
-  JobStore s(fresh_dir("sched"));
+  const auto dir = fresh_dir("sched");
+  JobStore s(dir);
   s.mark_running("j", kIn, "1234_5", "/runs/x/hpc/logs/mill-x-breakage_1234_5.out");
   s.mark_failed("j", "liggghts-mill exited with status 1");
   const Status st = s.read_status("j");
@@ -46,7 +46,8 @@ TEST(JobStore, SchedulerJobAndLogStayInStatus) {
 }
 
 TEST(JobStore, NewThenDoneIsSkipped) {
-  JobStore s(fresh_dir("done"));
+  const auto dir = fresh_dir("done");
+  JobStore s(dir);
   EXPECT_EQ(s.decide("j", kIn, false).decision, Decision::Run);
   s.mark_running("j", kIn);
   s.mark_done("j");
@@ -61,7 +62,8 @@ TEST(JobStore, NewThenDoneIsSkipped) {
 }
 
 TEST(JobStore, ChangedInputReruns) {
-  JobStore s(fresh_dir("changed"));
+  const auto dir = fresh_dir("changed");
+  JobStore s(dir);
   s.mark_running("j", kIn);
   s.mark_done("j");
   nlohmann::json changed = kIn;
@@ -72,7 +74,8 @@ TEST(JobStore, ChangedInputReruns) {
 }
 
 TEST(JobStore, FailedReruns) {
-  JobStore s(fresh_dir("failed"));
+  const auto dir = fresh_dir("failed");
+  JobStore s(dir);
   s.mark_running("j", kIn);
   s.mark_failed("j", "liggghts exit status 1");
   auto v = s.decide("j", kIn, false);
@@ -81,7 +84,7 @@ TEST(JobStore, FailedReruns) {
 }
 
 TEST(JobStore, RunningWithDeadPidReruns) {
-  const fs::path dir = fresh_dir("stale");
+  const auto dir = fresh_dir("stale");
   // A child marks the job running, then dies without finishing it.
   pid_t pid = fork();
   if (pid == 0) {
@@ -99,7 +102,8 @@ TEST(JobStore, RunningWithDeadPidReruns) {
 }
 
 TEST(JobStore, RunningWithLivePidIsBusy) {
-  JobStore s(fresh_dir("busy"));
+  const auto dir = fresh_dir("busy");
+  JobStore s(dir);
   s.mark_running("j", kIn);  // this very process: alive
   EXPECT_EQ(s.decide("j", kIn, false).decision, Decision::Busy);
 }
@@ -113,7 +117,7 @@ TEST(JobStore, PidReuseIsDetectedByStartTime) {
 }
 
 TEST(AtomicWrite, KilledWriterLeavesNoFinishedFile) {
-  const fs::path dir = fresh_dir("kill");
+  const auto dir = fresh_dir("kill");
   const fs::path out = dir / "summary.csv";
   pid_t pid = fork();
   if (pid == 0) {
@@ -137,7 +141,8 @@ TEST(AtomicWrite, KilledWriterLeavesNoFinishedFile) {
 }
 
 TEST(AtomicWrite, CompleteWriteIsVisible) {
-  const fs::path f = fresh_dir("ok") / "a.txt";
+  const auto dir = fresh_dir("ok");
+  const fs::path f = dir / "a.txt";
   atomic_write(f, "hello\n");
   std::ifstream in(f);
   std::string s;

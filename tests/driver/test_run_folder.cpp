@@ -19,6 +19,7 @@
 #include "engine/runner.h"
 #include "jobs/job_store.h"
 #include "jobs/run_lock.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using mill::jobs::RunFolderBusy;
@@ -26,12 +27,9 @@ using mill::jobs::RunLock;
 
 namespace {
 
-fs::path fresh_dir(const std::string& name) {
-  fs::path d =
-      fs::temp_directory_path() / ("mill_run_folder_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
+// An empty folder, removed when the test passes.
+mill::test::TempDir fresh_dir(const std::string& name) {
+  return mill::test::TempDir("mill_run_folder_" + name + "_" + std::to_string(getpid()));
 }
 
 struct Out {
@@ -53,7 +51,7 @@ Out orchestrate(const std::string& args) {
 const std::string kData = MILL_TEST_DATA;
 
 TEST(RunLock, SecondWriterIsTurnedAwayNamingTheHolder) {
-  const fs::path d = fresh_dir("lock");
+  const auto d = fresh_dir("lock");
   auto first = std::make_unique<RunLock>(d, RunLock::Mode::Exclusive, "orchestrate --stage all");
   try {
     RunLock second(d, RunLock::Mode::Exclusive, "orchestrate --stage breakage");
@@ -72,7 +70,7 @@ TEST(RunLock, SecondWriterIsTurnedAwayNamingTheHolder) {
 }
 
 TEST(RunLock, ArrayTasksShareTheFolderButNotWithAWholeRun) {
-  const fs::path d = fresh_dir("shared");
+  const auto d = fresh_dir("shared");
   RunLock a(d, RunLock::Mode::Shared, "orchestrate --task 0");
   EXPECT_NO_THROW(RunLock(d, RunLock::Mode::Shared, "orchestrate --task 1"));
   EXPECT_THROW(RunLock(d, RunLock::Mode::Exclusive, "orchestrate --stage breakage"), RunFolderBusy);
@@ -81,7 +79,7 @@ TEST(RunLock, ArrayTasksShareTheFolderButNotWithAWholeRun) {
 // Each stage has its own lock: a scheduler chain merges one stage while
 // another runs; the same stage is still one writer at a time.
 TEST(RunLock, StagesOfOneFolderLockApart) {
-  const fs::path d = fresh_dir("stages");
+  const auto d = fresh_dir("stages");
   RunLock flow(d, RunLock::Mode::Exclusive, "orchestrate --stage flow --merge-only", "flow");
   EXPECT_NO_THROW(RunLock(d, RunLock::Mode::Exclusive, "orchestrate --stage calibrate",
                           "calibrate"));
@@ -97,7 +95,7 @@ TEST(RunLock, StagesOfOneFolderLockApart) {
 
 // A second orchestrate on a folder in use exits 1 and says who holds it.
 TEST(RunLock, OrchestrateRefusesAFolderInUse) {
-  const fs::path d = fresh_dir("busy_cmd");
+  const auto d = fresh_dir("busy_cmd");
   RunLock held(d, RunLock::Mode::Exclusive, "orchestrate --stage all", "breakage");
   const Out o = orchestrate(
       "--case " + kData + "/good_small.yaml --stage breakage --merge-only --output " + d.string());
@@ -121,7 +119,7 @@ long gone_pid() {
 }
 
 TEST(StaleStatus, RunningForAGoneProcessIsStale) {
-  const fs::path d = fresh_dir("stale");
+  const auto d = fresh_dir("stale");
   const std::string args =
       "--case " + kData + "/good_small.yaml --stage breakage --output " + d.string();
   const std::string list = orchestrate(args + " --list-tasks").text;
@@ -153,7 +151,7 @@ bool process_gone(long pid) {
 // orchestrate killed outright (SIGKILL forwards nothing): the engine child
 // gets the parent-death signal and ends.
 TEST(Runner, EngineDiesWithAKilledOrchestrate) {
-  const fs::path d = fresh_dir("pdeath");
+  const auto d = fresh_dir("pdeath");
   const fs::path pid_file = d / "engine.pid";
   const pid_t orch = fork();
   if (orch == 0) {
@@ -209,7 +207,7 @@ int plan_with_pending_signal(int sig, const fs::path& out) {
 }
 
 TEST(PlanningSignals, SigtermAndSigintStopThePlan) {
-  const fs::path d = fresh_dir("plan_signal");
+  const auto d = fresh_dir("plan_signal");
   EXPECT_EQ(plan_with_pending_signal(SIGTERM, d / "run"), 143);
   EXPECT_EQ(plan_with_pending_signal(SIGINT, d / "run"), 130);
   EXPECT_FALSE(fs::exists(d / "run"));

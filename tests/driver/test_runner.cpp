@@ -10,17 +10,16 @@
 #include <thread>
 
 #include "engine/runner.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace mill::engine;
 
 namespace {
 
-fs::path fresh_dir(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("mill_runner_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
+// An empty folder, removed when the test passes.
+mill::test::TempDir fresh_dir(const std::string& name) {
+  return mill::test::TempDir("mill_runner_" + name + "_" + std::to_string(getpid()));
 }
 
 Command sh(const fs::path& dir, const std::string& script, Engine e = Engine::Generic) {

@@ -77,7 +77,7 @@ void write_synthetic_field(const fs::path& file) {
 class TinyTransport : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new fs::path(scratch("transport"));
+    dir_ = new mill::test::TempDir(scratch("transport"));
     std::ofstream(*dir_ / "case.yaml") << kCase << "flow: {allow_unconverged: true}\n";
     write_synthetic_field(*dir_ / "run" / "sample" / "rpm2000" / "field.h5");
     write_unconverged_sample_report(*dir_ / "run" / "sample" / "rpm2000" / "sample_report.json");
@@ -85,11 +85,11 @@ class TinyTransport : public ::testing::Test {
                               " --stage transport --output " + (*dir_ / "run").string(),
                           *dir_ / "transport.log");
   }
-  static void TearDownTestSuite() { delete dir_; }
-  static fs::path* dir_;
+  static void TearDownTestSuite() { delete dir_; }  // removed if every test passed
+  static mill::test::TempDir* dir_;
   static int status_;
 };
-fs::path* TinyTransport::dir_ = nullptr;
+mill::test::TempDir* TinyTransport::dir_ = nullptr;
 int TinyTransport::status_ = -1;
 
 TEST_F(TinyTransport, RunsAndWritesEveryOutput) {
@@ -194,7 +194,7 @@ TEST_F(TinyTransport, UnconvergedFlowOverrideIsRecorded) {
 // size (IDs renumbered 1..n per size) and gathers the classes' impact
 // statistics in transport/feed_classes.{json,csv}.
 TEST(TinyTransportFeed, FedClassesShareTheRunAndKeepTheirOwnStatistics) {
-  const fs::path dir = scratch("transport_feed");
+  const auto dir = scratch("transport_feed");
   std::ofstream(dir / "case.yaml")
       << kCase << "flow: {allow_unconverged: true}\n"
       << "feed: {sizes_mm: [16, 22.4, 31.5], mass_fractions: [0, 0, 1], rate_tph: 5, "
@@ -292,7 +292,7 @@ TEST(TinyTransportFeed, FedClassesShareTheRunAndKeepTheirOwnStatistics) {
 // injection.duration: a time limit that does not outlast that is refused,
 // naming the key and the sizes.
 TEST(TransportBadInput, SharedInjectionMustEndBeforeTheTimeLimit) {
-  const fs::path dir = scratch("transport_feed_badtime");
+  const auto dir = scratch("transport_feed_badtime");
   std::string text = kCase;
   const std::string from = "time_limit: 0.2", to = "time_limit: 0.03";
   ASSERT_NE(text.find(from), std::string::npos);
@@ -311,7 +311,7 @@ TEST(TransportBadInput, SharedInjectionMustEndBeforeTheTimeLimit) {
 
 // Without the sample stage's field the stage fails and names the file and the command.
 TEST(TransportMissingField, NamesFileAndCommand) {
-  const fs::path dir = scratch("transport_missing");
+  const auto dir = scratch("transport_missing");
   std::ofstream(dir / "case.yaml") << kCase;
   const int st = orchestrate("--case " + (dir / "case.yaml").string() +
                                  " --stage transport --output " + (dir / "run").string(),
@@ -329,7 +329,7 @@ namespace {
 // A field sampled from an unconverged flow stops the stage when the case does
 // not allow it, with a message that names the run, the key and what to do.
 TEST(TransportUnconvergedFlow, StopsWithTheMessage) {
-  const fs::path dir = scratch("transport_unconverged");
+  const auto dir = scratch("transport_unconverged");
   std::ofstream(dir / "case.yaml") << kCase;
   write_synthetic_field(dir / "run" / "sample" / "rpm2000" / "field.h5");
   write_unconverged_sample_report(dir / "run" / "sample" / "rpm2000" / "sample_report.json");
@@ -346,7 +346,7 @@ TEST(TransportUnconvergedFlow, StopsWithTheMessage) {
 
 // A time limit shorter than the injection is refused, naming the key.
 TEST(TransportBadInput, TimeLimitBelowDurationNamesKey) {
-  const fs::path dir = scratch("transport_badtime");
+  const auto dir = scratch("transport_badtime");
   std::string text = kCase;
   text.replace(text.find("time_limit: 0.2"), 15, "time_limit: 0.01");
   std::ofstream(dir / "case.yaml") << text;

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "postprocess/flow_field_io.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using mill::post::FlowField;
@@ -37,8 +38,9 @@ FlowField sample_field(bool turbulence) {
   return f;
 }
 
-fs::path tmp_file(const std::string& name) {
-  return fs::temp_directory_path() / ("mill_ffio_" + std::to_string(getpid()) + "_" + name);
+// A file path, removed when the test passes.
+mill::test::TempPath tmp_file(const std::string& name) {
+  return mill::test::TempPath("mill_ffio_" + std::to_string(getpid()) + "_" + name);
 }
 
 }  // namespace
@@ -65,14 +67,13 @@ TEST(FlowFieldIo, RoundTripKeepsDataAndAttributes) {
   EXPECT_EQ(mill::post::dataset_unit(file, "k"), "m^2/s^2");
   EXPECT_EQ(mill::post::dataset_unit(file, "omega"), "1/s");
   EXPECT_FALSE(fs::exists(file.string() + ".tmp." + std::to_string(getpid())));
-  fs::remove(file);
 }
 
 TEST(FlowFieldIo, DatasetShapesAreZYXAndComponents) {
   const auto f = sample_field(false);
   const auto file = tmp_file("shape.h5");
   mill::post::write_flow_field(file, f);
-  hid_t h = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  hid_t h = H5Fopen(file.path().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   ASSERT_GE(h, 0);
   hid_t ds = H5Dopen2(h, "U", H5P_DEFAULT);
   hid_t sp = H5Dget_space(ds);
@@ -90,7 +91,6 @@ TEST(FlowFieldIo, DatasetShapesAreZYXAndComponents) {
   H5Fclose(h);
   const auto g = mill::post::read_flow_field(file);
   EXPECT_TRUE(g.k.empty());
-  fs::remove(file);
 }
 
 TEST(FlowFieldIo, TrilinearLookupIsExactForLinearFieldAndHonoursMask) {
@@ -129,18 +129,19 @@ TEST(FlowFieldIo, GasAtGivesVelocityAtsVelocityAndTheLinearDensity) {
 }
 
 TEST(FlowFieldIo, ErrorsNameTheFileAndItem) {
+  const auto absent = tmp_file("absent.h5"), bad = tmp_file("bad.h5");
   try {
-    mill::post::read_flow_field(tmp_file("absent.h5"));
+    mill::post::read_flow_field(absent);
     FAIL();
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("absent.h5"), std::string::npos);
   }
   auto f = sample_field(false);
   f.rho.pop_back();
-  EXPECT_THROW(mill::post::write_flow_field(tmp_file("bad.h5"), f), std::invalid_argument);
+  EXPECT_THROW(mill::post::write_flow_field(bad, f), std::invalid_argument);
   // A file without the field datasets.
   const auto file = tmp_file("empty.h5");
-  hid_t h = H5Fcreate(file.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  hid_t h = H5Fcreate(file.path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
   H5Fclose(h);
   try {
     mill::post::read_flow_field(file);
@@ -148,5 +149,4 @@ TEST(FlowFieldIo, ErrorsNameTheFileAndItem) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("format_version"), std::string::npos) << e.what();
   }
-  fs::remove(file);
 }

@@ -9,16 +9,17 @@
 #include "geometry/mill_geometry.h"
 #include "stages/flow/case_files.h"
 #include "stages/flow/foam_results.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace mill::flow;
 
 namespace {
 
-fs::path write_log(const std::string& name, const std::string& text) {
-  const fs::path f =
-      fs::temp_directory_path() / ("mill_flowlog_" + std::to_string(getpid()) + "_" + name);
-  std::ofstream(f) << text;
+// A log file holding `text`, removed when the test passes.
+mill::test::TempPath write_log(const std::string& name, const std::string& text) {
+  mill::test::TempPath f("mill_flowlog_" + std::to_string(getpid()) + "_" + name);
+  std::ofstream(f.path()) << text;
   return f;
 }
 
@@ -53,7 +54,6 @@ TEST(FlowLog, ConvergedRun) {
   EXPECT_DOUBLE_EQ(s.initial_residual.at("p"), 8e-05)
       << "the first p solve of the iteration, not the corrector";
   EXPECT_DOUBLE_EQ(s.initial_residual.at("Ux"), 5e-05);
-  fs::remove(f);
 }
 
 TEST(FlowLog, NanAndFpeAreSeen) {
@@ -66,7 +66,6 @@ TEST(FlowLog, NanAndFpeAreSeen) {
   EXPECT_TRUE(s.nan);
   EXPECT_TRUE(s.fpe);
   EXPECT_FALSE(s.converged);
-  fs::remove(f);
 }
 
 TEST(FlowLog, PresetsGrowInResolution) {
@@ -96,7 +95,7 @@ TEST(FlowTemplate, MatchesTheDefaultCase) {
   ss << in.rdbuf();
   EXPECT_EQ(ss.str(), params)
       << "foam_case/system/caseParameters is stale: rerun this test with MILL_UPDATE_TEMPLATE=1";
-  const fs::path d = fs::temp_directory_path() / ("mill_tmpl_" + std::to_string(getpid()));
+  const mill::test::TempPath d("mill_tmpl_" + std::to_string(getpid()));
   const auto set = mill::geometry::write_stl_set(geo, d);
   for (const auto& f : {set.housing, set.flywheel, set.inlet, set.outlet}) {
     std::ifstream a(f), b(tmpl / "constant" / "triSurface" / f.filename());
@@ -105,7 +104,6 @@ TEST(FlowTemplate, MatchesTheDefaultCase) {
     sb << b.rdbuf();
     EXPECT_EQ(sa.str(), sb.str()) << f.filename() << " is stale: rerun with MILL_UPDATE_TEMPLATE=1";
   }
-  fs::remove_all(d);
 }
 
 namespace {

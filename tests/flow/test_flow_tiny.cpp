@@ -18,6 +18,7 @@
 #include "stages/flow_stage.h"
 #include "stages/sample_stage.h"
 #include "stages/transport_stage.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace mill;
@@ -28,16 +29,17 @@ const fs::path kData = MILL_FLOW_TEST_DATA;
 
 struct StageRun {
   config::CaseConfig cfg;
+  test::TempPath run_dir;  // the run folder, removed when the test passes
   RunOptions opts;
   engine::Runner runner;
   std::ostringstream out;
   Progress progress{out, false};
 
-  StageRun(const fs::path& yaml, int np) : cfg(config::load_case(yaml, MILL_PROJECT_DIR)) {
+  StageRun(const fs::path& yaml, int np)
+      : cfg(config::load_case(yaml, MILL_PROJECT_DIR)),
+        run_dir("mill_flow_" + cfg.name + "_" + std::to_string(getpid())) {
     opts.np = np;
-    opts.output =
-        fs::temp_directory_path() / ("mill_flow_" + cfg.name + "_" + std::to_string(getpid()));
-    fs::remove_all(opts.output);
+    opts.output = run_dir;
   }
   StageContext ctx(const std::string& stage) {
     return StageContext{cfg, opts, opts.output, opts.output / stage, runner, progress};
@@ -207,15 +209,14 @@ TEST(FlowTiny, IncompressibleMeshRunSample) {
   // stage stops, naming the key, the residuals and the run.
   EXPECT_EQ(rep["converged"], false);
   {
-    const fs::path strict =
-        fs::temp_directory_path() / ("mill_flow_strict_" + std::to_string(getpid()) + ".yaml");
+    const test::TempPath strict("mill_flow_strict_" + std::to_string(getpid()) + ".yaml");
     std::ifstream in(kData / "tiny.yaml");
     std::stringstream ss;
     ss << in.rdbuf();
     std::string t = ss.str();
     t.replace(t.find("allow_unconverged: true"), 23, "allow_unconverged: false");
     t.replace(t.find("name: flow_tiny"), 15, "name: flow_tiny_strict");  // StageRun clears its own folder
-    std::ofstream(strict) << t;
+    std::ofstream(strict.path()) << t;
     StageRun r2(strict, 1);
     r2.opts.output = r.opts.output;
     auto c = r2.ctx("sample");
@@ -242,7 +243,6 @@ TEST(FlowTiny, IncompressibleMeshRunSample) {
                                "sample_report.json"})
         EXPECT_NE(m.find(want), std::string::npos) << want << " not in: " << m;
     }
-    fs::remove(strict);
   }
   // Sampling is repeatable: the same case resampled gives bit-identical fields
   // (a threaded probe picked cells on shared faces by thread timing, up to
@@ -253,7 +253,6 @@ TEST(FlowTiny, IncompressibleMeshRunSample) {
   const auto second = post::read_flow_field(field);
   EXPECT_EQ(first.U, second.U);
   EXPECT_EQ(first.mask, second.mask);
-  fs::remove_all(r.opts.output);
 }
 
 TEST(FlowTiny, CompressibleOnTwoRanksMeshRunSample) {
@@ -287,7 +286,6 @@ TEST(FlowTiny, CompressibleOnTwoRanksMeshRunSample) {
   r.run(sample);
   check_outputs(r.opts.output, false, 1.0, 1.4);
   check_half_domain(r.opts.output, 1.0);  // rhoSimpleFoam's phi is kg/s
-  fs::remove_all(r.opts.output);
 }
 
 // Second-order momentum started with first-order upwind: two solver runs,
@@ -338,7 +336,6 @@ TEST(FlowTiny, SecondOrderStartsWithFirstOrderAtAFrozenRotorAngle) {
     EXPECT_NEAR(meshed[k].a[0], g.axis_x + c * dx - sn * dy, 1e-9);
     EXPECT_NEAR(meshed[k].a[1], g.axis_height + sn * dx + c * dy, 1e-9);
   }
-  fs::remove_all(r.opts.output);
 }
 
 // flow.domain = full: today's whole-housing case (no symmetry plane, nothing
@@ -362,10 +359,9 @@ TEST(FlowTiny, FullDomainOnTwoRanksMeshRunSample) {
   EXPECT_EQ(rep["rim"]["z_m"].get<double>(), 0.0);
   r.run(sample);
   check_outputs(r.opts.output, false, 1.2, 1.2);
-  EXPECT_EQ(read_json(r.opts.output / "sample" / "rpm2000" / "sample_report.json")
-                ["mirrored_about_z0"],
-            false);
-  fs::remove_all(r.opts.output);
+  EXPECT_EQ(
+      read_json(r.opts.output / "sample" / "rpm2000" / "sample_report.json")["mirrored_about_z0"],
+      false);
 }
 
 TEST(FlowTiny, SampleWithoutFlowSaysWhatIsMissing) {
@@ -382,15 +378,14 @@ TEST(FlowTiny, SampleWithoutFlowSaysWhatIsMissing) {
 }
 
 TEST(FlowTiny, CoarseSamplingSpacingNamesTheKey) {
-  const fs::path yaml =
-      fs::temp_directory_path() / ("mill_flow_coarse_" + std::to_string(getpid()) + ".yaml");
+  const test::TempPath yaml("mill_flow_coarse_" + std::to_string(getpid()) + ".yaml");
   {
     std::ifstream in(kData / "tiny.yaml");
     std::stringstream ss;
     ss << in.rdbuf();
     std::string t = ss.str();
     t.replace(t.find("spacing: 0.1"), 12, "spacing: 0.4");
-    std::ofstream(yaml) << t;
+    std::ofstream(yaml.path()) << t;
   }
   // Checked with the case, before any stage runs: file, line, key, limit.
   try {
@@ -401,7 +396,6 @@ TEST(FlowTiny, CoarseSamplingSpacingNamesTheKey) {
     for (const char* s : {".yaml:21: sample.spacing", "half the narrowest housing side (0.25 m of 0.5 m)", "got 0.4 m"})
       EXPECT_NE(m.find(s), std::string::npos) << s << " not in: " << m;
   }
-  fs::remove(yaml);
 }
 
 TEST(FlowTiny, DivergenceIsAnErrorNamingTheLog) {
@@ -421,5 +415,4 @@ TEST(FlowTiny, DivergenceIsAnErrorNamingTheLog) {
   }
   EXPECT_FALSE(fs::exists(r.opts.output / "flow" / plan.jobs[0].label))
       << "a failed run publishes nothing";
-  fs::remove_all(r.opts.output);
 }

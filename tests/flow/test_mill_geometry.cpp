@@ -8,6 +8,7 @@
 #include <map>
 
 #include "geometry/mill_geometry.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace mill::geometry;
@@ -73,7 +74,7 @@ TEST(MillGeometry, OpeningsPointIntoTheHousing) {
 
 TEST(MillGeometry, StlRoundTripOneSolidPerFile) {
   MillGeometry g;
-  const fs::path d = fs::temp_directory_path() / ("mill_geom_" + std::to_string(getpid()));
+  const mill::test::TempPath d("mill_geom_" + std::to_string(getpid()));
   const auto set = write_stl_set(g, d);
   for (const auto& [f, name] : {std::pair{set.housing, "housing"},
                                 {set.flywheel, "flywheel"},
@@ -88,7 +89,6 @@ TEST(MillGeometry, StlRoundTripOneSolidPerFile) {
   const auto back = read_stl(set.flywheel);
   EXPECT_EQ(back.size(), flywheel_surface(g).size());
   EXPECT_NEAR(signed_volume(back), signed_volume(flywheel_surface(g)), 1e-6);
-  fs::remove_all(d);
 }
 
 TEST(MillGeometry, FitErrorsNameTheKey) {

@@ -9,6 +9,7 @@
 
 #include "engine/runner.h"
 #include "stages/sample_stage.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace mill;
@@ -31,9 +32,9 @@ std::string header(const std::string& cls, const std::string& obj) {
 // (blockMesh numbers the cells of one block x fastest, then y, then z).
 // half: the face z = 0 is the symmetryPlane patch `symmetry`, as in the flow
 // stage's half-domain case (flow.domain = half).
-fs::path make_case(bool half = false) {
-  const fs::path d = fs::temp_directory_path() / ("mill_sampler_" + std::to_string(getpid()));
-  fs::remove_all(d);
+// Removed when the test passes.
+mill::test::TempDir make_case(bool half = false) {
+  mill::test::TempDir d("mill_sampler_" + std::to_string(getpid()));
   fs::create_directories(d / "system");
   fs::create_directories(d / "1");
   std::ofstream(d / "system" / "controlDict")
@@ -78,7 +79,7 @@ fs::path make_case(bool half = false) {
 }  // namespace
 
 TEST(Sampler, SolidBodyRotationMatchesAnalyticAndOutsideIsMasked) {
-  const fs::path d = make_case();
+  const auto d = make_case();
   sample::GridSpec g;
   g.lo = {-0.6, -0.6, 0.0};  // wider than the mesh in x and y: those points are outside
   g.hi = {0.6, 0.6, 0.2};
@@ -126,7 +127,6 @@ TEST(Sampler, SolidBodyRotationMatchesAnalyticAndOutsideIsMasked) {
       << "interior: interpolation of a linear field is exact";
   EXPECT_LT(worst_edge, kOmega * h)
       << "near the walls: within the interpolation error at the cell size";
-  fs::remove_all(d);
 }
 
 // A half-domain case (flow.domain = half) is the part z >= 0 of the mill,
@@ -136,7 +136,7 @@ TEST(Sampler, SolidBodyRotationMatchesAnalyticAndOutsideIsMasked) {
 // [-0.2, 0.2] must match the analytic field, the plane z = 0 must be gas, and
 // the field must be even in z (U_z odd, here 0).
 TEST(Sampler, HalfDomainIsMirroredAboutTheMidPlane) {
-  const fs::path d = make_case(true);
+  const auto d = make_case(true);
   sample::Options opt;
   opt.constant_rho = 1.2;
   for (double spacing : {0.04, 0.07}) {  // 11 planes (one at z = 0), 6 planes (none)
@@ -177,5 +177,4 @@ TEST(Sampler, HalfDomainIsMirroredAboutTheMidPlane) {
   bad.hi = {0.5, 0.5, 0.2};
   bad.spacing = 0.05;
   EXPECT_THROW(sample::resample_case(d, bad, opt), std::invalid_argument);
-  fs::remove_all(d);
 }

@@ -13,28 +13,48 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "temp_dir.h"
+
 namespace mill_test {
 
 namespace {
 
-// Run directories made by this process.
-std::vector<std::string> &run_dirs() {
-  static std::vector<std::string> dirs;
+// Run directories made by this process and not yet removed; in_test: made
+// while a test ran (else, e.g. in SetUpTestSuite, they last the program).
+struct RunDir {
+  std::string path;
+  bool in_test;
+};
+std::vector<RunDir> &run_dirs() {
+  static std::vector<RunDir> dirs;
   return dirs;
 }
 
-// Removes the run directories after a fully passing test program; keeps them
-// for inspection after a failure or when MILL_KEEP_TEST_DIRS is set.
-class RunDirCleanup : public ::testing::Environment {
+// Removes the run directories a test made when it ends, if it passed; keeps
+// them for inspection, printing their paths, after a failure or when
+// MILL_KEEP_TEST_DIRS is set. Those made outside a test go at the end of a
+// passing test program.
+class RunDirCleanup : public ::testing::EmptyTestEventListener {
  public:
-  void TearDown() override {
-    if (std::getenv("MILL_KEEP_TEST_DIRS") || !::testing::UnitTest::GetInstance()->Passed()) return;
-    std::error_code ec;
-    for (const auto &d : run_dirs()) std::filesystem::remove_all(d, ec);
+  void OnTestEnd(const ::testing::TestInfo &test) override { sweep(true, test.result()->Failed()); }
+  void OnTestProgramEnd(const ::testing::UnitTest &unit) override { sweep(false, unit.Failed()); }
+
+ private:
+  static void sweep(bool test_only, bool failed) {
+    auto &dirs = run_dirs();
+    for (auto it = dirs.begin(); it != dirs.end();) {
+      if (test_only && !it->in_test) {
+        ++it;
+        continue;
+      }
+      mill::test::remove_unless_failed(it->path, failed);
+      it = dirs.erase(it);
+    }
   }
 };
 
-const auto *const kCleanup = ::testing::AddGlobalTestEnvironment(new RunDirCleanup);
+const bool kCleanup =
+    (::testing::UnitTest::GetInstance()->listeners().Append(new RunDirCleanup), true);
 
 }  // namespace
 
@@ -44,7 +64,8 @@ std::string make_run_dir(const std::string &name) {
   std::vector<char> buf(templ.begin(), templ.end());
   buf.push_back('\0');
   if (!mkdtemp(buf.data())) throw std::runtime_error("mkdtemp failed for " + templ);
-  run_dirs().emplace_back(buf.data());
+  run_dirs().push_back(
+      {buf.data(), ::testing::UnitTest::GetInstance()->current_test_info() != nullptr});
   return std::string(buf.data());
 }
 

@@ -14,7 +14,8 @@ struct RunResult {
   std::string screen;  // stdout + stderr of the run
 };
 
-// Creates a fresh directory /tmp/styles_<name>_XXXXXX and returns its path.
+// Creates a fresh directory /tmp/styles_<name>_XXXXXX and returns its path;
+// it is removed when the test that made it passes, kept when it fails.
 std::string make_run_dir(const std::string &name);
 
 // Writes `deck` to dir/in.deck and runs liggghts-mill on it with nprocs ranks;

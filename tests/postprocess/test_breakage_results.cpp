@@ -58,7 +58,8 @@ ImpactResult MakeImpact(double v, int repeat, int n = 10, int k = 4) {
 }
 
 TEST(ImpactPieces, ReadBackFromAnImpactFileAsWritten) {
-  const std::string path = (TestDir() / "impact.h5").string();
+  const auto dir = TestDir();
+  const std::string path = (dir / "impact.h5").string();
   const ImpactResult r = MakeImpact(40.0, 0, 10, 4);
   WriteBreakageH5(path, {r});
   const ImpactPieces p = ReadImpactPieces(path);
@@ -69,7 +70,7 @@ TEST(ImpactPieces, ReadBackFromAnImpactFileAsWritten) {
     EXPECT_DOUBLE_EQ(p.d_rel[k], r.fragments[k].diameter / d_ref);
   }
   // A file of two impacts is not one run's.
-  const std::string two = (TestDir() / "two.h5").string();
+  const std::string two = (dir / "two.h5").string();
   WriteBreakageH5(two, {r, MakeImpact(20.0, 1)});
   try {
     ReadImpactPieces(two);

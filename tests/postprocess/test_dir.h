@@ -2,21 +2,20 @@
 #pragma once
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
-#include <filesystem>
 #include <string>
+
+#include "temp_dir.h"
 
 namespace mill::post {
 
-// A fresh empty directory named after the running test.
-inline std::filesystem::path TestDir() {
+// A fresh empty directory named after the running test (and this process),
+// removed when the test passes, kept when it fails.
+inline mill::test::TempDir TestDir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() /
-      (std::string("mill_post_") + info->test_suite_name() + "_" + info->name());
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
+  return mill::test::TempDir(std::string("mill_post_") + info->test_suite_name() + "_" +
+                             info->name() + "_" + std::to_string(getpid()));
 }
 
 }  // namespace mill::post

@@ -1,7 +1,5 @@
 // The energy ledger of a lump run: reading ledger.csv, bad files named by
 // file and line, the summary figures of a hand-written ledger, new surface.
-#include "postprocess/energy_ledger.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,7 +7,9 @@
 #include <filesystem>
 #include <fstream>
 
+#include "postprocess/energy_ledger.h"
 #include "postprocess/fragments.h"
+#include "test_dir.h"
 
 namespace mill::post {
 namespace {
@@ -26,16 +26,6 @@ const std::string kHeader =
     "contact_damping_J,contact_friction_J,work_other_J,input_J,residual_J,max_speed_m_s,wall_"
     "overlap\n";
 const std::string kRow0 = "0,0,12.5,0,0,0,0,0,0,0,0,0,0,0,0,0,12.5,0,150,0\n";
-
-// A fresh empty directory for one test.
-fs::path TestDir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir = fs::temp_directory_path() /
-                       (std::string("mill_post_") + info->test_suite_name() + "_" + info->name());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
 
 // The message ReadEnergyLedger (and SummariseLedger) gives for a file of
 // `text`, or "no error".
@@ -121,7 +111,8 @@ TEST(EnergyLedger, NegativeOtherWorkIsNotCountedAsGiven) {
 }
 
 TEST(EnergyLedger, BadFilesNameTheFileAndLine) {
-  const fs::path f = TestDir() / "ledger.csv";
+  const auto dir = TestDir();
+  const fs::path f = dir / "ledger.csv";
   const std::string name = f.string();
   auto has = [](const std::string& message, const std::string& part) {
     return message.find(part) != std::string::npos;
@@ -157,7 +148,8 @@ TEST(EnergyLedger, BadFilesNameTheFileAndLine) {
 // Columns beyond the fix's are kept, with a unit from their name; comments
 // and blank lines anywhere are skipped; CRLF line ends are read.
 TEST(EnergyLedger, ExtraColumnsAndCommentsAreKept) {
-  const fs::path f = TestDir() / "ledger.csv";
+  const auto dir = TestDir();
+  const fs::path f = dir / "ledger.csv";
   std::string header = kHeader;
   header.insert(header.size() - 1, ",residual_bonds_J");
   std::string row = kRow0;
@@ -180,7 +172,8 @@ TEST(EnergyLedger, ExtraColumnsAndCommentsAreKept) {
 }
 
 TEST(EnergyLedger, CsvMirrorReadsBackTheSame) {
-  const fs::path f = TestDir() / "energy_ledger.csv";
+  const auto dir = TestDir();
+  const fs::path f = dir / "energy_ledger.csv";
   const EnergyLedger a = ReadEnergyLedger(kSmall);
   WriteEnergyLedgerCsv(f.string(), a);
   EXPECT_FALSE(fs::exists(f.string() + ".tmp"));

@@ -8,6 +8,7 @@
 
 #include "postprocess/fragments.h"
 #include "postprocess/impact_conditions.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace mill::post;
@@ -16,9 +17,9 @@ namespace {
 
 // A hand-made impacts.csv: six flywheel impacts, two housing impacts.
 //   flywheel normal speeds 10, 12, 30, 31, 50, 2(slow: ignored below 5 m/s)
-fs::path HandMadeImpacts() {
-  const fs::path p = fs::temp_directory_path() / ("mill_impacts_" + std::to_string(getpid()) + ".csv");
-  std::ofstream o(p);
+mill::test::TempPath HandMadeImpacts() {
+  mill::test::TempPath p("mill_impacts_" + std::to_string(getpid()) + ".csv");
+  std::ofstream o(p.path());
   o << "time_s,particle_id,surface,x_m,y_m,z_m,speed_m_s,normal_speed_m_s,tangential_speed_m_s,angle_deg\n"
     << "0.01,1,flywheel,0,0,0,20,10,17.32,30\n"
     << "0.02,2,flywheel,0,0,0,24,12,20.78,30\n"
@@ -32,7 +33,8 @@ fs::path HandMadeImpacts() {
 }
 
 TEST(BinImpacts, EqualWidthBinsOfNormalSpeedWithShares) {
-  const auto impacts = ReadImpactsCsv(HandMadeImpacts().string());
+  const auto file = HandMadeImpacts();
+  const auto impacts = ReadImpactsCsv(file.string());
   ASSERT_EQ(impacts.size(), 8u);
   // Flywheel only, slower than 5 m/s ignored: normal speeds 10..50 in 4 bins of 10 m/s:
   // [10,20): 10, 12   [20,30): -   [30,40): 30, 31   [40,50]: 50
@@ -56,7 +58,8 @@ TEST(BinImpacts, EqualWidthBinsOfNormalSpeedWithShares) {
 }
 
 TEST(BinImpacts, WallImpactsWhenAsked) {
-  const auto impacts = ReadImpactsCsv(HandMadeImpacts().string());
+  const auto file = HandMadeImpacts();
+  const auto impacts = ReadImpactsCsv(file.string());
   const auto c = BinImpacts(impacts, {"flywheel", "housing"}, 1, 5.0);
   ASSERT_EQ(c.size(), 1u);
   EXPECT_EQ(c[0].count, 7);
@@ -64,7 +67,8 @@ TEST(BinImpacts, WallImpactsWhenAsked) {
 }
 
 TEST(BinImpacts, NoQualifyingImpactIsAnError) {
-  const auto impacts = ReadImpactsCsv(HandMadeImpacts().string());
+  const auto file = HandMadeImpacts();
+  const auto impacts = ReadImpactsCsv(file.string());
   EXPECT_THROW(BinImpacts(impacts, {"flywheel"}, 3, 1000.0), PostError);
   EXPECT_THROW(BinImpacts(impacts, {"flywheel"}, 0), PostError);
 }

@@ -1,8 +1,6 @@
 // Tests of postprocess/impact_stats: the impact CSV and trajectory readers,
 // the statistics on hand-made impact lists; and of postprocess/transport_h5:
 // transport.h5 units.
-#include "postprocess/impact_stats.h"
-
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -13,7 +11,9 @@
 
 #include "postprocess/flow_field_io.h"
 #include "postprocess/fragments.h"
+#include "postprocess/impact_stats.h"
 #include "postprocess/transport_h5.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace mill::post;
@@ -26,9 +26,10 @@ const char* kHeader =
     "vrel_x_m_s,vrel_y_m_s,vrel_z_m_s,speed_m_s,normal_speed_m_s,tangential_speed_m_s,angle_deg,"
     "surface_speed_m_s,particle_speed_m_s,axis_distance_m\n";
 
-fs::path temp_file(const std::string& name, const std::string& text) {
-  const fs::path p = fs::temp_directory_path() / (name + "_" + std::to_string(getpid()));
-  std::ofstream(p) << text;
+// A file holding `text`, removed when the test passes.
+mill::test::TempPath temp_file(const std::string& name, const std::string& text) {
+  mill::test::TempPath p(name + "_" + std::to_string(getpid()));
+  std::ofstream(p.path()) << text;
   return p;
 }
 
@@ -150,7 +151,7 @@ TEST(TransportH5, DatasetsCarryUnits) {
   meta.scalars = {{"rpm", 2000}};
   meta.units = {{"rpm", "1/min"}};
   meta.geometry = {{"tip_radius", 0.5}};
-  const fs::path p = fs::temp_directory_path() / ("transport_" + std::to_string(getpid()) + ".h5");
+  const mill::test::TempPath p("transport_" + std::to_string(getpid()) + ".h5");
   WriteTransportH5(p.string(), r, ComputeTransportStats(r, insert, ends), insert, tr, meta, ends);
   EXPECT_EQ(dataset_unit(p, "impacts/speed"), "m/s");
   EXPECT_EQ(dataset_unit(p, "impacts/angle"), "deg");
@@ -161,7 +162,6 @@ TEST(TransportH5, DatasetsCarryUnits) {
   EXPECT_EQ(dataset_unit(p, "strikes/housing_angle"), "deg");
   EXPECT_EQ(dataset_unit(p, "contact_ends/velocity"), "m/s");
   EXPECT_EQ(dataset_unit(p, "impacts/part"), "1");
-  fs::remove(p);
 }
 
 namespace {
@@ -361,7 +361,7 @@ TEST(ContactEndsCsv, ReadsColumnsByName) {
   EXPECT_DOUBLE_EQ(e[0].speed_m_s, 50.0);
   EXPECT_DOUBLE_EQ(e[0].normal_speed_m_s, 15.0);
   EXPECT_TRUE(std::isnan(e[1].normal_speed_m_s));
-  std::ofstream(p, std::ios::app) << "0.3,5,housing,0.29,fast,1,2,3,0,0,0,0,0,0,0,0,0,0,0\n";
+  std::ofstream(p.path(), std::ios::app) << "0.3,5,housing,0.29,fast,1,2,3,0,0,0,0,0,0,0,0,0,0,0\n";
   try {
     ReadContactEndsCsv(p.string());
     FAIL() << "no error";
@@ -380,7 +380,7 @@ TEST(ImpactCsv, LabelsRoundTrip) {
   r[0].contact = {0.3, 1.21, 0};
   r[1].normal = {0, 1, 0};
   LabelImpacts(r, MillShape{}, 1.0);
-  const fs::path p = fs::temp_directory_path() / ("labelled_" + std::to_string(getpid()) + ".csv");
+  const mill::test::TempPath p("labelled_" + std::to_string(getpid()) + ".csv");
   WriteImpactsCsv(p.string(), r);
   const auto back = ReadImpactsCsv(p.string());
   ASSERT_EQ(back.size(), 2u);
@@ -390,5 +390,4 @@ TEST(ImpactCsv, LabelsRoundTrip) {
   EXPECT_EQ(back[1].part, "floor");
   EXPECT_TRUE(back[1].sliding);
   EXPECT_DOUBLE_EQ(back[0].speed_m_s, 90.0);
-  fs::remove(p);
 }

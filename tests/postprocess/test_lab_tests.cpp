@@ -3,8 +3,6 @@
 // the Mohr-Coulomb and Hoek-Brown envelopes of synthetic peaks; the
 // semi-circular bend toughness; the calibration step on analytic response
 // models.
-#include "postprocess/lab_tests.h"
-
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -12,6 +10,9 @@
 #include <cstdio>
 #include <fstream>
 #include <optional>
+
+#include "postprocess/lab_tests.h"
+#include "temp_dir.h"
 
 namespace mill::post {
 namespace {
@@ -122,7 +123,7 @@ TEST(LabTests, ReadsTheDeckCurveFormatAndNamesABadLine) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find(":4:"), std::string::npos) << e.what();
   }
-  std::remove(name);
+  mill::test::remove_unless_failed(name, HasFailure());
 }
 
 // A triaxial curve file as the deck writes it: the confining force column is
@@ -157,7 +158,7 @@ TEST(LabTestsTriaxial, ReadsTheCurveFileWithTheConfiningForce) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find(":4: expected 9 numbers"), std::string::npos) << e.what();
   }
-  std::remove(name);
+  mill::test::remove_unless_failed(name, HasFailure());
 }
 
 // Peak of sigma_1 - sigma_3 of a hand-made curve: a confinement of 5 MPa on a

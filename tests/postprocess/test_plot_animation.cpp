@@ -3,6 +3,7 @@
 // differ; a missing, truncated or incomplete dump stops it with a message
 // naming the file.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdlib>
@@ -11,6 +12,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+
+#include "temp_dir.h"
 
 namespace mill::post {
 namespace {
@@ -89,16 +92,14 @@ Outcome Render(const fs::path& dir, const fs::path& frames) {
   return {st, Slurp(dir / "err.txt")};
 }
 
-fs::path Fresh(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("mill_post_plot_animation_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+// An empty folder, removed when the test passes.
+mill::test::TempDir Fresh(const std::string& name) {
+  return mill::test::TempDir("mill_post_plot_animation_" + name + "_" + std::to_string(getpid()));
 }
 
 TEST(PlotAnimation, ReadsEveryFrameAndDrawsAGifWhoseFramesDiffer) {
   if (!PythonHasPlotting()) GTEST_SKIP() << kPython << " lacks matplotlib/numpy/PIL";
-  const fs::path dir = Fresh("ok");
+  const auto dir = Fresh("ok");
   // Three snapshots; the three elements move from x = 0.02 to 0.32 and up 0.4 m.
   std::ofstream(dir / "frames.dump")
       << Snapshot(0, 0.0, 3, -0.2, 0.6) << Snapshot(100, 1e-3, 3, 0.0, 0.8)
@@ -133,7 +134,7 @@ TEST(PlotAnimation, ReadsEveryFrameAndDrawsAGifWhoseFramesDiffer) {
 
 TEST(PlotAnimation, MissingDumpNamesTheFile) {
   if (!PythonHasPlotting()) GTEST_SKIP() << kPython << " lacks matplotlib/numpy/PIL";
-  const fs::path dir = Fresh("missing");
+  const auto dir = Fresh("missing");
   const Outcome r = Render(dir, dir / "nothing.dump");
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find((dir / "nothing.dump").string() + ": cannot read the frame dump"),
@@ -144,7 +145,7 @@ TEST(PlotAnimation, MissingDumpNamesTheFile) {
 
 TEST(PlotAnimation, TruncatedSnapshotNamesTheFileAndStep) {
   if (!PythonHasPlotting()) GTEST_SKIP() << kPython << " lacks matplotlib/numpy/PIL";
-  const fs::path dir = Fresh("truncated");
+  const auto dir = Fresh("truncated");
   std::ofstream(dir / "frames.dump")
       << Snapshot(0, 0.0, 3, -0.2, 0.6) << Snapshot(100, 1e-3, 3, 0.0, 0.8, 1);
   const Outcome r = Render(dir, dir / "frames.dump");
@@ -158,7 +159,7 @@ TEST(PlotAnimation, TruncatedSnapshotNamesTheFileAndStep) {
 
 TEST(PlotAnimation, MissingColumnAndGarbageNameTheFileAndLine) {
   if (!PythonHasPlotting()) GTEST_SKIP() << kPython << " lacks matplotlib/numpy/PIL";
-  const fs::path dir = Fresh("column");
+  const auto dir = Fresh("column");
   std::string s = Snapshot(0, 0.0, 2, -0.2, 0.6);
   s.replace(s.find(" v_frame_time"), 13, "");
   std::ofstream(dir / "frames.dump") << s;

@@ -1,6 +1,7 @@
 // plot_breakage.py on a small hand-made sweep: PNGs exist, critical velocity
 // agrees with the C++ FindCriticalVelocity.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include "postprocess/breakage_results.h"
 #include "postprocess/distributions.h"
 #include "postprocess/jk_fit.h"
+#include "temp_dir.h"
 
 namespace mill::post {
 namespace {
@@ -26,9 +28,7 @@ bool PythonHasPlotting() {
 
 TEST(PlotBreakage, WritesPngsAndCriticalVelocity) {
   if (!PythonHasPlotting()) GTEST_SKIP() << kPython << " lacks matplotlib/numpy";
-  const fs::path dir = fs::temp_directory_path() / "mill_post_plot_breakage";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const mill::test::TempDir dir("mill_post_plot_breakage_" + std::to_string(getpid()));
   const std::string summary = (dir / "summary.csv").string();
   const std::string passing = (dir / "size_distributions.csv").string();
   std::ofstream pass(passing);
@@ -83,9 +83,7 @@ TEST(PlotBreakage, WritesPngsAndCriticalVelocity) {
 
 TEST(PlotJk, DrawsPointsFitAndOreCardAndNamesABadFile) {
   if (!PythonHasPlotting()) GTEST_SKIP() << kPython << " lacks matplotlib/numpy";
-  const fs::path dir = fs::temp_directory_path() / "mill_post_plot_jk";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const mill::test::TempDir dir("mill_post_plot_jk_" + std::to_string(getpid()));
   std::ofstream pts(dir / "jk_points.csv");
   pts << "angle_deg,velocity_m_s,repeat,ecs_kWh_t,t10_percent,t10_resolved\n";
   for (double v : {20.0, 60.0, 100.0, 150.0}) {
@@ -112,8 +110,7 @@ TEST(PlotJk, DrawsPointsFitAndOreCardAndNamesABadFile) {
 // A summary.csv without ledgers (efficiency NaN) draws no efficiency plot.
 TEST(PlotBreakage, NoEfficiencyPlotWithoutLedgers) {
   if (!PythonHasPlotting()) GTEST_SKIP() << kPython << " lacks matplotlib/numpy";
-  const fs::path dir = fs::temp_directory_path() / "mill_post_plot_no_ledger";
-  fs::remove_all(dir);
+  const mill::test::TempDir dir("mill_post_plot_no_ledger_" + std::to_string(getpid()));
   fs::create_directories(dir / "plots");
   std::ofstream(dir / "plots" / "comminution_efficiency_vs_velocity.png") << "stale";
   const std::string summary = (dir / "summary.csv").string();
@@ -135,9 +132,7 @@ TEST(PlotBreakage, NoEfficiencyPlotWithoutLedgers) {
 // a column stops with the file, line and column.
 TEST(PlotEnergyLedger, DrawsTheStackAndNamesAMissingColumn) {
   if (!PythonHasPlotting()) GTEST_SKIP() << kPython << " lacks matplotlib/numpy";
-  const fs::path dir = fs::temp_directory_path() / "mill_post_plot_ledger";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const mill::test::TempDir dir("mill_post_plot_ledger_" + std::to_string(getpid()));
   const std::string base = kPython + " " + MILL_PLOT_ENERGY_LEDGER_SCRIPT + " --ledger ";
   const std::string good = base + MILL_POST_TEST_DATA + "/ledger_small.csv --out " +
                            (dir / "energy_ledger.png").string() + " --title '150 m/s at 90 deg'";
@@ -155,9 +150,7 @@ TEST(PlotEnergyLedger, DrawsTheStackAndNamesAMissingColumn) {
 
 TEST(PlotBreakage, MissingColumnFailsWithItsName) {
   if (!PythonHasPlotting()) GTEST_SKIP() << kPython << " lacks matplotlib/numpy";
-  const fs::path dir = fs::temp_directory_path() / "mill_post_plot_bad";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const mill::test::TempDir dir("mill_post_plot_bad_" + std::to_string(getpid()));
   std::ofstream(dir / "s.csv") << "velocity_m_s,angle_deg\n1,90\n";
   const std::string cmd = kPython + " " + kScript + " --summary " + (dir / "s.csv").string() +
                           " --out " + (dir / "o").string() + " 2> " + (dir / "err.txt").string();
