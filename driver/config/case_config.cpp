@@ -620,8 +620,9 @@ void check_physics(const Document& d) {
                                           "({:g} s), got {:g} s",
                                           after, bdt));
   // The adaptive step (on by default) acts on the automatic step only; asked
-  // for in the file together with a given step, it is a contradiction.
-  if (d.boolean("breakage.adaptive_step") && d.line("breakage.adaptive_step") > 0 && bdt > 0)
+  // for in the file or on the command line (--set) together with a given
+  // step, it is a contradiction.
+  if (d.boolean("breakage.adaptive_step") && d.line("breakage.adaptive_step") != 0 && bdt > 0)
     fail("breakage.adaptive_step",
          fmt::format(
              "the adaptive step re-evaluates the automatic step; expected breakage.timestep: 0 "

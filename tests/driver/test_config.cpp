@@ -272,4 +272,10 @@ TEST(CaseFile, AdaptiveStepIsTheDefaultWithTheAutomaticStep) {
     const auto cfg = load_case(f, kProject);
     EXPECT_EQ(mill::breakage::adaptive_step_on(cfg.doc), c.on) << c.text;
   }
+  // Asked for as an override (not in the file) with a given step: refused too.
+  const fs::path f = dir / "case.yaml";
+  std::ofstream(f) << "name: e\nbreakage:\n  timestep: 1.0e-7\n";
+  EXPECT_THROW(load_case(f, kProject, {{"breakage.adaptive_step", "true"}}),
+               mill::config::ConfigError);
+  EXPECT_NO_THROW(load_case(f, kProject, {{"breakage.adaptive_step", "false"}}));
 }
