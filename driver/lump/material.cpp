@@ -176,7 +176,9 @@ BondParams bond_params_for_set(const config::CaseConfig& cfg, const fs::path& ru
     throw std::runtime_error(fmt::format(
         "{}: no calibration of start {} fitted to this ore card with the case's bond model "
         "({}); run `orchestrate --stage calibrate` with calibrate.starts >= {}",
-        f.string(), k, fs::exists(f) ? "fitted to other properties or another model" : "missing",
+        f.string(), k,
+        fs::exists(f) ? "fitted to other properties, another lump scale or another model"
+                      : "missing",
         k));
   c.origin = fmt::format("calibration set {} ({})", k, f.string());
   return c;
