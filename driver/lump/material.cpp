@@ -94,9 +94,7 @@ bool read_calibrated_file(const fs::path& file, const std::string& hash, BondPar
   b.origin = "calibrated (" + file.string() + ")";
   return true;
 }
-}  // namespace
 
-namespace {
 // What a calibrated: map `c` (complete, with another input_hash than the
 // case's, or another model) was fitted for, against the case: one clause.
 std::string mismatch(const YAML::Node& c, const config::CaseConfig& cfg) {
@@ -133,12 +131,13 @@ std::string mismatch(const YAML::Node& c, const config::CaseConfig& cfg) {
 std::string file_reason(const fs::path& file, const config::CaseConfig& cfg, const char* what) {
   if (!fs::exists(file)) return fmt::format("no {} ({})", what, file.string());
   try {
+    BondParams b = estimate_bond_params(cfg.ore, cfg.doc);
+    if (read_calibrated_file(file, calibration_hash(cfg), b)) return "";
+    // Not taken: read it again only to say why.
     const YAML::Node root = YAML::LoadFile(file.string());
     const YAML::Node c = root.IsMap() ? root[kCalibratedSection] : YAML::Node();
     if (!c || !c.IsMap() || !c[kInputHashKey])
       return fmt::format("{} {} has no complete calibrated: section", what, file.string());
-    BondParams b = estimate_bond_params(cfg.ore, cfg.doc);
-    if (read_calibrated_file(file, calibration_hash(cfg), b)) return "";
     return fmt::format("{} {}: {}", what, file.string(), mismatch(c, cfg));
   } catch (const std::exception& e) {
     return fmt::format("{} {}: unreadable ({})", what, file.string(), e.what());
