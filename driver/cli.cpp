@@ -19,6 +19,7 @@
 #include "engine/runner.h"
 #include "hpc.h"
 #include "jobs/run_lock.h"
+#include "lump/material.h"
 #include "pipeline.h"
 #include "run_folder.h"
 #include "stages/stage.h"
@@ -502,6 +503,18 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
     if (a.check) {
       out << fmt::format("{}: case '{}' is valid; ore card {} ({})\n", cfg.file.string(), cfg.name,
                          cfg.ore_file.string(), cfg.ore.str("name"));
+      // What a calibrated: section must carry to be taken for this case's
+      // lump (docs/calibration.md): for calibrations written by hand or
+      // carried over from another run.
+      const nlohmann::json fitted_for = lump_scale(cfg);
+      std::string scale;
+      for (const auto& [k, v] : fitted_for.items())
+        scale += fmt::format("{}{} {}", scale.empty() ? "" : ", ", k,
+                             v.is_boolean() ? (v.get<bool>() ? "true" : "false")
+                                            : fmt::format("{:.6g}", v.get<double>()));
+      out << fmt::format(
+          "calibration key of this ore card and lump: input_hash {} (fitted_for: {})\n",
+          calibration_hash(cfg), scale);
       return 0;
     }
     return stage_command(cfg, a, command, out, err);

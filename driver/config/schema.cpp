@@ -407,6 +407,14 @@ std::vector<KeyDef> breakage_keys() {
               "there within a chunk at its speed towards the axis), and every element whose "
               "latest flywheel contact came after its latest housing contact has left the "
               "housing (docs/breakage.md); false = every run lasts duration"),
+          key("breakage.in_mill.skip_free_flight", T::Bool, "", "true",
+              "In-mill breakage: start the engine run where the lump's free flight ends, not "
+              "lead_time before the strike: until an element touches a surface the lump moves as "
+              "one rigid body along the ballistic path its start was backed off along, so the "
+              "run starts once its bounding sphere is within half its radius of the housing or "
+              "the turning flywheel (the skipped time is in_mill.json's "
+              "start.free_flight_skipped_s; docs/breakage.md); false = the whole lead time is "
+              "simulated"),
           key("breakage.in_mill.animate", T::Bool, "", "true",
               "In-mill breakage: the first in-mill run (the first lump of the first rotor speed) "
               "also writes 60 frames over duration, drawn as an animation in the report "

@@ -155,6 +155,13 @@ TEST(InMill, StruckLumpBreaksUnreachableOneOnlyOnTheHousingAndARunResumesAfterAK
   EXPECT_EQ(missed.at("flywheel").at("contacts").get<long>(), 0) << missed.dump(2);
   EXPECT_EQ(missed.at("bonds_broken_at_strike").get<long>(), 0) << missed.dump(2);
   EXPECT_GT(missed.at("housing").at("contacts").get<long>(), 0) << missed.dump(2);
+  // The free flight (breakage.in_mill.skip_free_flight, on by default): the
+  // lump flying above the rotor has no surface within reach over the whole
+  // lead time (2 ms), which is skipped whole; the struck lump is the animated
+  // run (the first of the plan), which keeps its lead time.
+  EXPECT_DOUBLE_EQ(missed.at("start").at("free_flight_skipped_s").get<double>(), 2.0e-3)
+      << missed.dump(2);
+  EXPECT_EQ(struck.at("start").at("free_flight_skipped_s").get<double>(), 0.0) << struck.dump(2);
   // The early stop: each run says when and why it stopped.
   const auto& gone = missed.at("stop");
   EXPECT_EQ(gone.at("reason").get<std::string>(), "work_done") << missed.dump(2);
@@ -344,11 +351,70 @@ TEST(InMill, AnimationOffWritesNoFramesAndKeepsTheOtherJobIds) {
   EXPECT_EQ(slurp(dir / "off.log").find("animated"), std::string::npos) << slurp(dir / "off.log");
 }
 
+// The struck lump's free flight skipped (breakage.in_mill.skip_free_flight)
+// and simulated: the engine run starts later, with the lump's bounding sphere
+// at least half its radius from the mill, on the ballistic path (closed
+// form); its first flywheel contact comes at the same time on the job's
+// clock, to two steps (the flight between is exact but for round-off in
+// both runs), after the deck's start.
+TEST(InMill, FreeFlightSkippedMeetsTheBeaterWhenTheFullLeadTimeDoes) {
+  const auto dir = scratch("in_mill_free_flight");
+  std::string yaml = slurp(kData + "/tiny_in_mill.yaml");
+  const std::string from = "duration: 8.0e-3, lead_time: 2.0e-3, gas: false}";
+  ASSERT_NE(yaml.find(from), std::string::npos);
+  nlohmann::json runs[2];
+  for (int skip = 0; skip < 2; ++skip) {
+    const fs::path run = dir / (skip ? "skip" : "full");
+    write_transport_impacts(run);
+    std::string y = yaml;
+    y.replace(y.find(from), from.size(),
+              std::string("duration: 3.0e-3, lead_time: 2.0e-3, gas: false, animate: false, "
+                          "skip_free_flight: ") +
+                  (skip ? "true}" : "false}"));
+    spit(run / "case.yaml", y);
+    ASSERT_EQ(orchestrate("--case " + (run / "case.yaml").string() +
+                              " --stage breakage --task 1 --output " + run.string(),
+                          run / "run.log"),
+              0)
+        << slurp(run / "run.log");
+    runs[skip] = nlohmann::json::parse(slurp(run / "breakage/jobs/rpm2000_mill_p1/in_mill.json"));
+  }
+  const auto& full = runs[0];
+  const auto& skip = runs[1];
+  EXPECT_EQ(full.at("start").at("free_flight_skipped_s").get<double>(), 0.0) << full.dump(2);
+  const auto& s = skip.at("start");
+  const double t = s.at("free_flight_skipped_s").get<double>();
+  EXPECT_GT(t, 1.0e-3) << skip.dump(2);
+  EXPECT_LT(t, 2.0e-3) << skip.dump(2);
+  const double r = 0.5 * skip.at("lump").at("outer_diameter_m").get<double>();
+  EXPECT_GE(s.at("deck_start").at("gap_to_mill_m").get<double>(), 0.5 * r) << skip.dump(2);
+  const auto& x0 = s.at("position_m");
+  const auto& v0 = s.at("velocity_m_s");
+  EXPECT_NEAR(s.at("deck_start").at("position_m")[1].get<double>(),
+              x0[1].get<double>() + v0[1].get<double>() * t - 0.5 * 9.81 * t * t, 1e-12);
+  EXPECT_NEAR(s.at("deck_start").at("velocity_m_s")[1].get<double>(),
+              v0[1].get<double>() - 9.81 * t, 1e-12);
+  EXPECT_NEAR(s.at("deck_start").at("rotor_angle_deg").get<double>(),
+              s.at("rotor_angle_deg").get<double>() + 2000 * 2 * kPi / 60 * t * 180 / kPi, 1e-9);
+  const double first_full = full.at("first_flywheel_contact_s").get<double>();
+  const double first_skip = skip.at("first_flywheel_contact_s").get<double>();
+  EXPECT_GT(first_skip, t) << skip.dump(2);
+  const std::string log = slurp(dir / "skip/breakage/jobs/rpm2000_mill_p1/run/liggghts.log");
+  const auto at = log.find("in_mill: dt ");
+  ASSERT_NE(at, std::string::npos);
+  const double dt = std::stod(log.substr(at + 12));
+  EXPECT_NEAR(first_skip, first_full, 2 * dt) << full.dump(2) << skip.dump(2);
+  // Both ran to the same end on the job's clock (3 ms, to a 0.25 ms chunk).
+  EXPECT_GE(skip.at("stop").at("time_s").get<double>(), 3.0e-3 - 1e-9) << skip.dump(2);
+  EXPECT_LT(skip.at("stop").at("time_s").get<double>(), 3.0e-3 + 2.5e-4) << skip.dump(2);
+}
+
 // With gas: still air of 1.2 kg/m3 over the tiny housing (a field where the
 // sample stage puts it); the run takes the drag and says so. One lump of the
 // two is chosen: the one of the median strike normal speed, lump 2 (41.9 m/s
 // against 35.7), the one the beater cannot reach. With the early stop off
-// it runs its whole 4 ms, and its record says so.
+// it runs its whole 4 ms, and its record says so; with the free flight
+// simulated (skip_free_flight false) the drag acts over all of it.
 TEST(InMill, GasDragFromTheSampledField) {
   const auto dir = scratch("in_mill_gas");
   write_transport_impacts(dir);
@@ -363,7 +429,7 @@ TEST(InMill, GasDragFromTheSampledField) {
   ASSERT_NE(yaml.find(from), std::string::npos);
   yaml.replace(yaml.find(from), from.size(),
                "in_mill: {lumps: 1, duration: 4.0e-3, lead_time: 2.0e-3, gas: true, "
-               "early_stop: false}");
+               "early_stop: false, skip_free_flight: false}");
   spit(dir / "case.yaml", yaml);
   ASSERT_EQ(orchestrate("--case " + (dir / "case.yaml").string() + " --stage breakage --output " +
                             dir.string(),
@@ -376,6 +442,8 @@ TEST(InMill, GasDragFromTheSampledField) {
   EXPECT_EQ(j.at("stop").at("reason").get<std::string>(), "t_end") << j.dump(2);
   EXPECT_GE(j.at("stop").at("time_s").get<double>(), 4.0e-3 - 1e-9) << j.dump(2);
   EXPECT_EQ(j.at("bonds_broken_at_strike").get<long>(), 0) << j.dump(2);
+  EXPECT_EQ(j.at("start").at("free_flight_skipped_s").get<double>(), 0.0) << j.dump(2);
+  EXPECT_EQ(j.at("start").at("deck_start").at("position_m"), j.at("start").at("position_m"));
   // Still air only takes energy from the lump, and it took some.
   EXPECT_LT(j.at("energy").at("work_gas_J").get<double>(), 0.0) << j.dump(2);
   EXPECT_NE(

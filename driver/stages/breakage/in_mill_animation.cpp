@@ -41,7 +41,7 @@ double frame_interval(const nlohmann::json& inputs) {
 
 void render_animation(StageContext& ctx, const JobSpec& job, const fs::path& work,
                       const fs::path& stl_dir, const geometry::MillGeometry& g,
-                      const fs::path& out_dir) {
+                      const fs::path& out_dir, double lead_s) {
   const auto& in = job.inputs;
   const fs::path dump = work / "frames.dump";
   if (!fs::exists(dump))
@@ -50,7 +50,7 @@ void render_animation(StageContext& ctx, const JobSpec& job, const fs::path& wor
         "s); log: {}",
         job.label, dump.string(), num(frame_interval(in)), (work / "liggghts.log").string()));
   const double rpm = in.at("rpm").get<double>();
-  const double lead_ms = 1e3 * ctx.cfg.doc.real("breakage.in_mill.lead_time");
+  const double lead_ms = 1e3 * lead_s;
   const std::string caption = fmt::format(
       "Lump {} at {:g} rpm ({}): t = 0 is {:g} ms before its first flywheel strike ({:.1f} m/s)",
       in.at("particle_id").get<long long>(), rpm, job.label, lead_ms,

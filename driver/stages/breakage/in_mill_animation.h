@@ -33,11 +33,12 @@ bool is_animated(const JobSpec& job);
 double frame_interval(const nlohmann::json& inputs);
 
 // Draws the run's frame dump (work/frames.dump) with the mill of the run
-// (the STL files in stl_dir) into out_dir/animation; throws naming the dump
-// and the log when it is missing or broken.
+// (the STL files in stl_dir) into out_dir/animation; the frames start
+// lead_s before the strike. Throws naming the dump and the log when it is
+// missing or broken.
 void render_animation(StageContext& ctx, const JobSpec& job, const std::filesystem::path& work,
                       const std::filesystem::path& stl_dir, const geometry::MillGeometry& g,
-                      const std::filesystem::path& out_dir);
+                      const std::filesystem::path& out_dir, double lead_s);
 
 // The animation of an animated job's folder exists and parses: "" or the reason.
 std::string damaged_animation(const std::filesystem::path& job_dir);

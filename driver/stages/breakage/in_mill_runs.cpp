@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "engine/liggghts.h"
+#include "geometry/free_flight.h"
 #include "geometry/mill_geometry.h"
 #include "jobs/job_store.h"
 #include "jobs/output_checks.h"
@@ -33,6 +34,9 @@ constexpr double kG = 9.81;
 constexpr int kInMillDeckVersion = 5;
 // Facets of the flywheel's hub circle in the in-mill runs (see run_in_mill).
 constexpr int kHubFacets = 24;
+// The lump's free flight ends this many of its bounding radii from the
+// nearest surface (breakage.in_mill.skip_free_flight).
+constexpr double kFreeFlightClearance = 0.5;
 // Neighbour skin in mean element radii: the turning flywheel forces a list
 // build whenever its tips have moved half the skin (every ~25 steps at 0.3
 // radii and 105 m/s); one radius builds 3 x less often (bench/README.md).
@@ -125,6 +129,7 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan,
                                    "breakage.in_mill.lead_time",
                                    "breakage.in_mill.gas",
                                    "breakage.in_mill.early_stop",
+                                   "breakage.in_mill.skip_free_flight",
                                    "breakage.in_mill.neighbour_bins",
                                    "transport.sliding_threshold"};
   if (gas)
@@ -273,7 +278,7 @@ std::vector<std::pair<std::string, std::string>> in_mill_vars(
       {"viscosity", num(d.real("gas.viscosity"))},
       {"tip_radius", num(g.tip_radius())},
       {"housing_top", num(g.height)},
-      {"t_end", num(d.real("breakage.in_mill.duration"))},
+      {"t_end", num(d.real("breakage.in_mill.duration") - in.value("free_flight_skipped_s", 0.0))},
       {"early_stop", d.boolean("breakage.in_mill.early_stop") ? "1" : "0"},
       {"stop_margin", num(in.at("lump.diameter").get<double>())},
       {"dt", num(d.real("breakage.timestep"))},
@@ -285,6 +290,53 @@ std::vector<std::pair<std::string, std::string>> in_mill_vars(
       {"frame_interval", num(frame_interval(in))}};
   for (const auto& kv : lump_deck_vars(ctx, lr)) v.push_back(kv);
   return v;
+}
+
+// Where the engine run starts: the job's start, or with
+// breakage.in_mill.skip_free_flight (and no animation frames) the end of the
+// lump's free flight from it (geometry/free_flight.h), at most lead_time
+// later: the job's inputs with that position, velocity, rotor angle and
+// free_flight_skipped_s.
+struct DeckStart {
+  nlohmann::json inputs;
+  double skipped = 0;  // s
+  double gap = 0;      // m, the lump's bounding sphere to the nearest surface at the deck's start
+};
+
+DeckStart deck_start(const config::Document& d, const nlohmann::json& in, const LumpRun& lr) {
+  DeckStart s;
+  s.inputs = in;
+  const geometry::MillGeometry g = run_geometry(d, in);
+  geometry::FreeFlightQuery q;
+  q.x0 = vec3(in.at("position"));
+  q.v0 = vec3(in.at("velocity"));
+  q.gravity = {0.0, -kG, 0.0};
+  q.radius = lr.lump.outer_radius;
+  q.clearance = kFreeFlightClearance * lr.lump.outer_radius;
+  // Without the skip, the flight looked at is none: the gap at the start
+  // only. The animated run keeps its whole lead time: the report shows the
+  // lump coming to the beater.
+  q.horizon = d.boolean("breakage.in_mill.skip_free_flight") && frame_interval(in) <= 0
+                  ? d.real("breakage.in_mill.lead_time")
+                  : 0.0;
+  q.axis_origin = g.axis_centre();
+  q.omega = omega_of(in.at("rpm").get<double>());
+  const geometry::FreeFlight f =
+      geometry::free_flight_time(geometry::housing_surface(g), geometry::flywheel_surface(g), q);
+  s.gap = f.gap_at_time;
+  if (f.time <= 0) return s;
+  const double t = f.time;
+  s.skipped = t;
+  nlohmann::json x = nlohmann::json::array(), v = nlohmann::json::array();
+  for (int k = 0; k < 3; ++k) {
+    x.push_back(q.x0[k] + q.v0[k] * t + 0.5 * q.gravity[k] * t * t);
+    v.push_back(q.v0[k] + q.gravity[k] * t);
+  }
+  s.inputs["position"] = x;
+  s.inputs["velocity"] = v;
+  s.inputs["rotor_angle_rad"] = in.at("rotor_angle_rad").get<double>() + q.omega * t;
+  s.inputs["free_flight_skipped_s"] = t;
+  return s;
 }
 
 // Walls are impenetrable: an element beside the housing, between floor and
@@ -427,17 +479,26 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
     spec->tag = fmt::format("_d{:.4g}mm", 1e3 * spec->diameter);
   }
   const LumpRun lr = prepare_lump_run(ctx, repeat, out_dir, label, 1, spec ? &*spec : nullptr);
-  const geometry::MillGeometry g = run_geometry(d, in);
+  // The engine run starts where the lump's free flight ends (or at the
+  // job's start): `deck` is the job's inputs with that start.
+  const DeckStart start = deck_start(d, in, lr);
+  const nlohmann::json& deck = start.inputs;
+  const geometry::MillGeometry g = run_geometry(d, deck);
   fs::create_directories(lr.work);
   const geometry::StlSet stl = geometry::write_stl_set(g, lr.work / "stl");
-  const StepBound step = step_bound(d, g, lr, vec3(in.at("velocity")), omega_of(rpm));
+  const StepBound step = step_bound(d, g, lr, vec3(deck.at("velocity")), omega_of(rpm));
 
   engine::DeckRun run;
   run.deck = ctx.cfg.project_dir / "liggghts_inputs" / "in_mill.in.tmpl";
   run.workdir = lr.work;
   run.np = ctx.opts.np;
   run.job = "breakage/" + label;
-  run.vars = in_mill_vars(ctx, in, g, stl, lr, field_file, step);
+  run.vars = in_mill_vars(ctx, deck, g, stl, lr, field_file, step);
+  if (start.skipped > 0)
+    ctx.progress.info(fmt::format(
+        "[breakage] {}: free flight to {:.3f} ms of the {:g} ms lead time skipped (the lump "
+        "{:.1f} mm from the nearest surface then)",
+        label, 1e3 * start.skipped, 1e3 * d.real("breakage.in_mill.lead_time"), 1e3 * start.gap));
   const engine::Result res = engine::run_deck(ctx.runner, run, ctx.progress, label);
 
   // Fragments, judged at the strike's relative speed (its specific energy).
@@ -453,10 +514,31 @@ std::string run_in_mill(StageContext& ctx, const JobSpec& job, const fs::path& o
     throw std::runtime_error(fmt::format("{}: {}", label, e.what()));
   }
 
-  if (is_animated(job)) render_animation(ctx, job, lr.work, lr.work / "stl", g, out_dir);
+  // The record's times on the job's clock (from lead_time before the strike).
+  const auto shift = [&](double& t) {
+    if (t >= 0) t += start.skipped;
+  };
+  shift(record.stop.time_s);
+  shift(record.split.first_flywheel_contact_s);
+  shift(record.split.first_housing_contact_s);
+
+  if (is_animated(job))
+    render_animation(ctx, job, lr.work, lr.work / "stl", g, out_dir,
+                     d.real("breakage.in_mill.lead_time") - start.skipped);
 
   nlohmann::json j = lump_result_json(lr, a, res.seconds);
   add_in_mill_keys(j, d, in, record);
+  j["start"]["free_flight_skipped_s"] = start.skipped;
+  j["start"]["deck_start"] = {
+      {"position_m", deck.at("position")},
+      {"velocity_m_s", deck.at("velocity")},
+      {"rotor_angle_deg", deck.at("rotor_angle_rad").get<double>() * 180 / kPi},
+      {"gap_to_mill_m", start.gap},
+      {"note",
+       "the engine run starts free_flight_skipped_s after the start above: the lump's free "
+       "flight (one rigid body under gravity, no surface within half its bounding radius) is "
+       "not simulated (breakage.in_mill.skip_free_flight); the times of this file count from "
+       "the start above, those of run/ (impacts.csv, ledger.csv) from the engine run's"}};
   jobs::atomic_write(out_dir / "in_mill.json", j.dump(2) + "\n");
   write_lump_outputs(out_dir, a, j);
   return in_mill_line(in, a, record, res.seconds);
