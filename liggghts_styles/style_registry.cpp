@@ -2,6 +2,7 @@
 
 #include <map>
 
+#include "fix_balance_weighted.h"
 #include "fix_bond_breakable.h"
 #include "fix_bond_flatjoint.h"
 #include "fix_energy_ledger.h"
@@ -64,6 +65,9 @@ std::vector<std::string> register_mill_styles(LAMMPS_NS::LAMMPS *lmp) {
   names.emplace_back(LAMMPS_NS::FixEnergyWork::style_name());
   (*fix_map)[LAMMPS_NS::FixStepAdaptive::style_name()] = &create_fix<LAMMPS_NS::FixStepAdaptive>;
   names.emplace_back(LAMMPS_NS::FixStepAdaptive::style_name());
+  (*fix_map)[LAMMPS_NS::FixBalanceWeighted::style_name()] =
+      &create_fix<LAMMPS_NS::FixBalanceWeighted>;
+  names.emplace_back(LAMMPS_NS::FixBalanceWeighted::style_name());
   return names;
 }
 

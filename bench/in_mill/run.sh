@@ -4,6 +4,7 @@
 #   DURATION=0.005 bench/in_mill/run.sh      a shorter run (s) for comparing settings
 #   LEAD_TIME=5e-5 DURATION=2.5e-4 ...        a run that starts closer to the strike (s)
 #   ADAPTIVE=1 DURATION=0.005 bench/in_mill/run.sh   with breakage.adaptive_step: true
+#   NP=2 bench/in_mill/run.sh                 the engine run on 2 MPI ranks
 # The reference lump (3344 elements, the reference calibration's bonds) in the
 # reference mill at 2000 rpm for 20 ms on one core: stage 1's impact record is
 # one strike written here (the lump falling at 10 m/s onto plate 0's leading
@@ -53,7 +54,7 @@ if [ -n "${DURATION:-}${LEAD_TIME:-}${ADAPTIVE:-}" ]; then
   case_file="$out.case.yaml"
 fi
 /usr/bin/time -v "$build/bin/orchestrate" --case "$case_file" --stage breakage --task 1 \
-  --output "$out" 2> "$out/in_mill.time" | tee "$out/in_mill.log"
+  --np "${NP:-1}" --output "$out" 2> "$out/in_mill.time" | tee "$out/in_mill.log"
 job="$out/breakage/jobs/rpm2000_mill_p1"
 grep -q '"bond_parameters_origin": "calibrated' "$job/result.json" || echo "WARNING: the bonds were not the calibrated ones"
 log="$job/run/liggghts.log"
