@@ -37,6 +37,9 @@ constexpr int kMaxSurfaces = 16;
 // both hold.
 constexpr double kBinsPerTriangle = 4.0;
 constexpr double kEntriesPerTriangle = 32.0;
+// The grid's boxes are grown by this many bin edges (of the triangles' own
+// box at kBinsPerTriangle), and it is kept while no node has moved farther.
+constexpr double kGridSlackBins = 0.25;
 
 // Small 3-vector helpers: dot product, difference, cross product c = a x b.
 inline double dot3(const double *a, const double *b) {
@@ -343,8 +346,24 @@ void FixImpactRecorder::load_triangles(Surface &s) {
     for (int d = 0; d < 3; ++d) s.normal[3 * t + d] = len > 0.0 ? nrm[d] / len : 0.0;
   }
   s.loaded = true;
-  s.grid_reach = -1.0;
-  if (prefilter_) build_grid(s);
+  if (prefilter_ && !grid_holds(s)) build_grid(s);
+}
+
+// Whether the grid still answers for the triangles just loaded: built for
+// this step's query reach (or more), from as many triangles, none of whose
+// nodes has moved farther than the grid's slack since. A triangle within r of
+// a point lies then within r + slack of where its grid boxes were made, so
+// the point's bin still lists it (a superset, in ascending order: the same
+// nearest point as a new grid or the full loop).
+bool FixImpactRecorder::grid_holds(const Surface &s) const {
+  if (s.grid_reach < query_reach_ || s.grid_tri.size() != s.tri.size()) return false;
+  const double slack2 = s.grid_slack * s.grid_slack;
+  for (size_t v = 0; v < s.tri.size(); v += 3) {
+    double d[3];
+    sub3(&s.tri[v], &s.grid_tri[v], d);
+    if (dot3(d, d) > slack2) return false;
+  }
+  return true;
 }
 
 // The largest radius nearest_point is asked for this step on this rank: the
@@ -360,12 +379,15 @@ void FixImpactRecorder::set_query_reach() {
 }
 
 // Bins the triangles of s into a uniform grid: each triangle goes into every
-// bin that its bounding box, grown by this step's query reach (plus a margin
-// far above rounding), meets, so that a triangle within the reach of a point
-// is always among the triangles of the point's bin. Bins are cubes sized for
+// bin that its bounding box, grown by this step's query reach, the slack
+// (grid_holds) and a margin far above rounding, meets, so that a triangle
+// within the reach of a point is always among the triangles of the point's
+// bin, until one of its nodes has moved farther than the slack. Bins are cubes sized for
 // about kBinsPerTriangle bins per triangle, and grow while the entries pass
 // kEntriesPerTriangle per triangle (large triangles over small bins).
 void FixImpactRecorder::build_grid(Surface &s) {
+  s.grid_reach = -1.0;  // no grid until this one is built
+  s.grid_tri.clear();
   const int n = static_cast<int>(s.normal.size() / 3);
   if (n == 0) return;  // no triangles here: the box test already says no contact
   double ext[3], lo[3], widest = 0.0, far = 0.0;
@@ -373,7 +395,12 @@ void FixImpactRecorder::build_grid(Surface &s) {
     widest = std::max(widest, s.box[2 * d + 1] - s.box[2 * d]);
     far = std::max({far, std::fabs(s.box[2 * d]), std::fabs(s.box[2 * d + 1])});
   }
-  const double pad = query_reach_ * (1.0 + 1e-9) + 1e-9 * (widest + far);
+  // The slack: a quarter of the bin edge the triangles' own box would get,
+  // so a turning mesh keeps its grid while its nodes move that far.
+  double vol = 1.0;
+  for (int d = 0; d < 3; ++d) vol *= s.box[2 * d + 1] - s.box[2 * d];
+  const double slack = kGridSlackBins * std::cbrt(std::max(0.0, vol) / (kBinsPerTriangle * n));
+  const double pad = query_reach_ * (1.0 + 1e-9) + slack + 1e-9 * (widest + far);
   for (int d = 0; d < 3; ++d) {
     lo[d] = s.box[2 * d] - pad;
     ext[d] = s.box[2 * d + 1] + pad - lo[d];
@@ -445,6 +472,8 @@ void FixImpactRecorder::build_grid(Surface &s) {
   }
   s.grid_h = h;
   s.grid_reach = query_reach_;
+  s.grid_slack = slack;
+  s.grid_tri = s.tri;
 }
 
 // The triangles of the bin holding x, as [*first, *last); false if x lies

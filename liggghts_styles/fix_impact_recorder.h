@@ -117,6 +117,12 @@ class FixImpactRecorder : public Fix {
     double grid_reach = -1.0;  // largest radius the grid answers (< 0: no grid)
     std::vector<int> cell_start;
     std::vector<int> cell_tri;
+    // The triangles the grid was built from, and how far their nodes may
+    // move from there before it must be built again (its boxes were grown
+    // by this slack too): a turning or static mesh keeps its grid for many
+    // steps instead of rebuilding it at each.
+    std::vector<double> grid_tri;
+    double grid_slack = 0.0;  // [m]
   };
   std::vector<Surface> surfaces_;
   std::string file_path_;
@@ -147,6 +153,7 @@ class FixImpactRecorder : public Fix {
   void load_triangles(Surface &s);
   void set_query_reach();
   void build_grid(Surface &s);
+  bool grid_holds(const Surface &s) const;
   void set_bound(Surface &s);
   Fix *mesh_neighbour_counts(const Surface &s, int *wall_groupbit) const;
   bool nearest_point(Surface &s, const double *x, double radius, double *c);
