@@ -22,6 +22,7 @@
 #include "fix_property_atom.h"
 #include "memory.h"
 #include "modify.h"
+#include "postprocess/closest_point.h"
 #include "style_args.h"
 #include "update.h"
 
@@ -52,57 +53,6 @@ inline void cross3(const double *a, const double *b, double *c) {
   c[0] = a[1] * b[2] - a[2] * b[1];
   c[1] = a[2] * b[0] - a[0] * b[2];
   c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-// Nearest point c of triangle (a, b, t) to p, by the Voronoi regions of the
-// triangle's vertices, edges and face (Ericson 2005, Real-Time Collision
-// Detection, sec. 5.1.5).
-void closest_on_triangle(const double *p, const double *a, const double *b, const double *t,
-                         double *c) {
-  double ab[3], at[3], ap[3];
-  sub3(b, a, ab);
-  sub3(t, a, at);
-  sub3(p, a, ap);
-  const double d1 = dot3(ab, ap), d2 = dot3(at, ap);
-  if (d1 <= 0.0 && d2 <= 0.0) {  // vertex a
-    for (int k = 0; k < 3; ++k) c[k] = a[k];
-    return;
-  }
-  double bp[3];
-  sub3(p, b, bp);
-  const double d3 = dot3(ab, bp), d4 = dot3(at, bp);
-  if (d3 >= 0.0 && d4 <= d3) {  // vertex b
-    for (int k = 0; k < 3; ++k) c[k] = b[k];
-    return;
-  }
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {  // edge ab
-    const double v = d1 / (d1 - d3);
-    for (int k = 0; k < 3; ++k) c[k] = a[k] + v * ab[k];
-    return;
-  }
-  double tp[3];
-  sub3(p, t, tp);
-  const double d5 = dot3(ab, tp), d6 = dot3(at, tp);
-  if (d6 >= 0.0 && d5 <= d6) {  // vertex t
-    for (int k = 0; k < 3; ++k) c[k] = t[k];
-    return;
-  }
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {  // edge at
-    const double w = d2 / (d2 - d6);
-    for (int k = 0; k < 3; ++k) c[k] = a[k] + w * at[k];
-    return;
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {  // edge bt
-    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    for (int k = 0; k < 3; ++k) c[k] = b[k] + w * (t[k] - b[k]);
-    return;
-  }
-  const double denom = 1.0 / (va + vb + vc);  // inside the face
-  const double v = vb * denom, w = vc * denom;
-  for (int k = 0; k < 3; ++k) c[k] = a[k] + ab[k] * v + at[k] * w;
 }
 
 }  // namespace
@@ -553,7 +503,7 @@ bool FixImpactRecorder::nearest_point(Surface &s, const double *x, double radius
     sub3(x, p, ap);
     if (std::fabs(dot3(ap, &s.normal[3 * t])) >= radius) return;
     double q[3];
-    closest_on_triangle(x, p, p + 3, p + 6, q);
+    mill::post::closest_on_triangle(x, p, p + 3, p + 6, q);
     double dq[3];
     sub3(x, q, dq);
     const double d2 = dot3(dq, dq);

@@ -6,6 +6,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "postprocess/closest_point.h"
+
 namespace mill::geometry {
 namespace {
 
@@ -25,31 +27,8 @@ double distance_to(const Vec3& p, const Surface& s) {
 }  // namespace
 
 double point_triangle_distance(const Vec3& p, const Triangle& t) {
-  // Barycentric tests of the Voronoi regions in turn: vertex a, vertex b,
-  // edge ab, vertex c, edge ac, edge bc, else the face (Ericson 2005,
-  // sec. 5.1.5).
-  const Vec3 ab = sub(t.b, t.a), ac = sub(t.c, t.a);
-  const Vec3 ap = sub(p, t.a);
-  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return norm(ap);
-  const Vec3 bp = sub(p, t.b);
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return norm(bp);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return norm(sub(p, axpy(t.a, d1 / (d1 - d3), ab)));
-  const Vec3 cp = sub(p, t.c);
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return norm(cp);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return norm(sub(p, axpy(t.a, d2 / (d2 - d6), ac)));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)
-    return norm(sub(p, axpy(t.b, (d4 - d3) / ((d4 - d3) + (d5 - d6)), sub(t.c, t.b))));
-  const double sum = va + vb + vc;
-  if (!(sum > 0)) {  // a degenerate (zero-area) facet: its nearest vertex
-    return std::min({norm(ap), norm(bp), norm(cp)});
-  }
-  const Vec3 q = axpy(axpy(t.a, vb / sum, ab), vc / sum, ac);
+  Vec3 q;
+  post::closest_on_triangle(p.data(), t.a.data(), t.b.data(), t.c.data(), q.data());
   return norm(sub(p, q));
 }
 

@@ -18,7 +18,7 @@ namespace mill::geometry {
 
 // Distance from point p to the triangle (its closest point by the Voronoi
 // regions of its vertices, edges and face: Ericson 2005, Real-Time Collision
-// Detection, sec. 5.1.5).
+// Detection, sec. 5.1.5; postprocess/closest_point.h, the impact recorder's).
 double point_triangle_distance(const Vec3& p, const Triangle& t);
 
 struct FreeFlightQuery {

@@ -120,4 +120,29 @@ std::string bonded_ball_head(double half_xy, double z_top) {
   return d.str();
 }
 
+// Final positions (id -> xyz) from a `dump custom id x y z` file.
+std::map<int, std::array<double, 3>> read_positions(const std::string &path) {
+  std::map<int, std::array<double, 3>> pos;
+  std::ifstream in(path);
+  std::string line;
+  bool atoms = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("ITEM: ATOMS", 0) == 0) {
+      atoms = true;
+      pos.clear();
+      continue;
+    }
+    if (line.rfind("ITEM:", 0) == 0) {
+      atoms = false;
+      continue;
+    }
+    if (!atoms) continue;
+    std::istringstream ls(line);
+    int id;
+    double x, y, z;
+    if (ls >> id >> x >> y >> z) pos[id] = {x, y, z};
+  }
+  return pos;
+}
+
 }  // namespace mill_test

@@ -7,6 +7,7 @@
 #define MILL_TESTS_BOND_TEST_UTIL_H
 
 #include <array>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -85,6 +86,9 @@ std::vector<std::vector<double>> last_run_rows(const std::string &path);
 // Times where column col crosses level upwards (linear interpolation; column 0 = time).
 std::vector<double> crossings_up(const std::vector<std::vector<double>> &rows, int col,
                                  double level);
+
+// Final positions (id -> xyz) from a `dump custom id x y z` file (the last snapshot).
+std::map<int, std::array<double, 3>> read_positions(const std::string &path);
 
 }  // namespace mill_test
 

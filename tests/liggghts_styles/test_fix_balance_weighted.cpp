@@ -65,21 +65,7 @@ BalanceRun run_block(int nprocs, bool balance, const std::string &boundary) {
   const auto r = run_deck(dir, d.str(), nprocs);
   EXPECT_EQ(r.exit_code, 0) << r.screen;
   BalanceRun out;
-  {
-    std::ifstream in(dir + "/final.dump");
-    std::string line;
-    bool atoms = false;
-    while (std::getline(in, line)) {
-      if (line.rfind("ITEM:", 0) == 0) {
-        atoms = line.rfind("ITEM: ATOMS", 0) == 0;
-        continue;
-      }
-      std::istringstream ls(line);
-      int id;
-      std::array<double, 3> p{};
-      if (atoms && (ls >> id >> p[0] >> p[1] >> p[2])) out.x[id] = p;
-    }
-  }
+  out.x = read_positions(dir + "/final.dump");
   // The run statistics' last "Nlocal: AVE ave MAX max MIN min".
   const auto at = r.screen.rfind("Nlocal:");
   if (at != std::string::npos) {
