@@ -310,7 +310,7 @@ Document Document::parse(const std::string& text, const std::string& file_label,
   Validator v(schema, file_label, overridden);
   v.walk(root, "", d.values_, d.lines_);
   for (const auto& k : schema.keys) {
-    if (d.values_.count(k.path)) continue;
+    if (d.values_.count(k.path) || k.default_if) continue;
     if (!k.default_yaml.empty()) {
       d.values_[k.path] = YAML::Load(k.default_yaml);
       d.lines_[k.path] = 0;
@@ -318,6 +318,15 @@ Document Document::parse(const std::string& text, const std::string& file_label,
       throw ConfigError(fmt::format("{}: {}: required key is missing; expected {} ({})", file_label, k.path,
                                     expected_text(k), k.doc));
     }
+  }
+  // The defaults that follow another key, once every plain default is in.
+  for (const auto& k : schema.keys) {
+    if (d.values_.count(k.path) || !k.default_if) continue;
+    const auto other = d.values_.find(k.default_if->when);
+    const bool met = other != d.values_.end() && other->second.IsScalar() &&
+                     other->second.Scalar() == k.default_if->is;
+    d.values_[k.path] = YAML::Load(met ? k.default_if->yaml : k.default_yaml);
+    d.lines_[k.path] = 0;
   }
   d.check_plausible();
   return d;

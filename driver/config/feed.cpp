@@ -20,6 +20,7 @@ constexpr const char* kN = "feed.rosin_rammler.n";
 constexpr const char* kRate = "feed.rate_tph";
 constexpr const char* kCut = "feed.cut_size_mm";
 constexpr const char* kTarget = "feed.target_p80_mm";
+constexpr const char* kCap = "feed.class_element_cap";
 constexpr const char* kFeedKeys[] = {kSizes, kFractions, kD63, kN, kRate, kCut, kTarget};
 
 [[noreturn]] void fail(const Document& d, const std::string& key, const std::string& msg) {
@@ -149,7 +150,14 @@ void check_shared_injection(const Document& d, const Feed& f) {
 
 std::optional<Feed> read_feed(const Document& d) {
   const std::string anchor = first_given(d);
-  if (anchor.empty()) return std::nullopt;
+  if (anchor.empty()) {
+    if (d.line(kCap) > 0)
+      fail(d, kCap,
+           "sets the size of a feed class's in-mill lump, and the case has no feed: add "
+           "feed.sizes_mm, feed.mass_fractions (or feed.rosin_rammler), feed.rate_tph and "
+           "feed.cut_size_mm, or remove feed.class_element_cap");
+    return std::nullopt;
+  }
   require(d, kSizes, anchor);
   require(d, kRate, anchor);
   require(d, kCut, anchor);

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "config/case_config.h"
+#include "lump/packing.h"
 #include "postprocess/population_balance.h"
 
 namespace mill::config {
@@ -53,7 +54,11 @@ std::vector<FeedClassRuns> plan_feed_classes(const Document& d, const Feed& f) {
   const std::size_t n = c.size();
   const long k_lumps = d.integer("breakage.in_mill.lumps");
   const long n_ref = d.integer("lump.n_elements");
-  const double d_ref = d.real("lump.diameter");
+  const double spread = d.real("lump.radius_spread");
+  // The calibration's element size: the mean element radius of lump.diameter's lump.
+  const double r_cal = target_mean_radius(n_ref, d.real("lump.diameter"), spread);
+  const long cap =
+      (d.has("feed.class_element_cap") ? d.integer("feed.class_element_cap") : kFeedClassElementCap) * n_ref;
   std::vector<FeedClassRuns> out;
   for (std::size_t i = 0; i < n; ++i) {
     FeedClassRuns r;
@@ -76,10 +81,8 @@ std::vector<FeedClassRuns> plan_feed_classes(const Document& d, const Feed& f) {
         r.in_mill = true;
     }
     if (r.in_mill) {
-      const double ratio = r.diameter_m / d_ref;
-      const long want = std::lround(static_cast<double>(n_ref) * ratio * ratio * ratio);
-      r.n_elements = std::clamp(want, kMinLumpElements, kFeedClassElementCap * n_ref);
-      r.element_size = ratio / std::cbrt(static_cast<double>(r.n_elements) / n_ref);
+      r.n_elements = std::clamp(elements_for_radius(r_cal, r.diameter_m, spread), kMinLumpElements, cap);
+      r.element_size = target_mean_radius(r.n_elements, r.diameter_m, spread) / r_cal;
     }
     out.push_back(r);
   }

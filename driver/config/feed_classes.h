@@ -21,9 +21,10 @@ class Document;
 // A class with less than this share of the feed has no runs of its own
 // (a table's zeros; a Rosin-Rammler feed's far tails).
 inline constexpr double kFeedClassMinFraction = 1e-3;
-// A class lump has at most this many times lump.n_elements (a lump of twice
-// lump.diameter at the calibration's element size); coarser classes keep
-// the cap and get coarser elements.
+// A class lump has at most this many times lump.n_elements when the case
+// does not set feed.class_element_cap (a lump of about twice lump.diameter
+// at the calibration's element size); coarser classes get the cap and
+// coarser elements.
 inline constexpr long kFeedClassElementCap = 8;
 
 struct FeedClassRuns {
@@ -34,7 +35,7 @@ struct FeedClassRuns {
   bool transport = false;    // a stage-1 run of its own (transport/class_<k>/<rpm>/)
   bool in_mill = false;      // in-mill runs of its own (breakage.in_mill.lumps of them)
   long n_elements = 0;       // elements of its bonded lump (when in_mill)
-  double element_size = 1;   // its mean element radius / the calibration's (1 unless capped)
+  double element_size = 1;   // its mean element radius / the calibration's (1 to the count's rounding, unless capped)
   std::string without_runs;  // why it has no transport run, or no in-mill runs ("" if both)
 };
 
@@ -47,10 +48,10 @@ struct FeedClassRuns {
 //   step at the fastest tip speed;
 // - in-mill runs when it has a transport run, breakage.in_mill.lumps > 0 and
 //   it is not the finest class (whose breakage no sieve sees);
-// - the in-mill lump's elements: lump.n_elements x (d / lump.diameter)^3
-//   rounded (the element size of lump.diameter's lump, for which the
-//   calibration was made), at least kMinLumpElements and at most
-//   kFeedClassElementCap x lump.n_elements.
+// - the in-mill lump's elements: the count whose mean element radius
+//   (target_mean_radius) is that of lump.diameter's lump, for which the
+//   calibration was made (elements_for_radius), at least kMinLumpElements
+//   and at most feed.class_element_cap x lump.n_elements.
 std::vector<FeedClassRuns> plan_feed_classes(const Document& d, const Feed& f);
 
 }  // namespace mill::config

@@ -30,6 +30,10 @@ KeyDef at_least(KeyDef k, double lo) {
   k.min = lo;
   return k;
 }
+KeyDef default_if(KeyDef k, std::string when, std::string is, std::string yaml) {
+  k.default_if = DefaultIf{std::move(when), std::move(is), std::move(yaml)};
+  return k;
+}
 KeyDef range(KeyDef k, double lo, bool lo_ex, double hi, bool hi_ex) {
   k.min = lo;
   k.min_exclusive = lo_ex;
@@ -383,12 +387,14 @@ std::vector<KeyDef> breakage_keys() {
                    1),
           key("breakage.include_wall_impacts", T::Bool, "", "false",
               "transport conditions: also wall impacts"),
-          at_least(key("breakage.in_mill.lumps", T::Int, "", "0",
-                       "In-mill breakage (needs conditions: transport): lumps per rotor speed run "
-                       "as bonded lumps in the "
-                       "turning mill from stage 1's first flywheel strikes, chosen spread over the "
-                       "strike speeds; 0 = none"),
-                   0),
+          default_if(at_least(key("breakage.in_mill.lumps", T::Int, "", "0",
+                                  "In-mill breakage (needs conditions: transport): lumps per rotor speed "
+                                  "(and feed class) run as bonded lumps in the turning mill from stage 1's "
+                                  "first flywheel strikes, chosen spread over the strike speeds; 0 = none. "
+                                  "The default 4 gives the product and the decision a band (a bootstrap "
+                                  "over the lumps; bench/README.md, \"Feed to product\")"),
+                              0),
+                     "breakage.conditions", "transport", "4"),
           positive(key("breakage.in_mill.duration", T::Real, "s", "0.02",
                        "In-mill breakage: simulated time of each run, from lead_time before the "
                        "strike (long enough for "
@@ -469,7 +475,14 @@ std::vector<KeyDef> feed_keys() {
                        "finest sieve. Required with a feed"))),
       opt(sieve_mm(key("feed.target_p80_mm", T::Real, "mm", "",
                        "Feed: the product P80 wanted (optional); at or above the finest sieve and below "
-                       "feed.cut_size_mm")))};
+                       "feed.cut_size_mm"))),
+      opt(range(key("feed.class_element_cap", T::Int, "", "",
+                "Feed: most elements of a class's in-mill lump, as a multiple of lump.n_elements; absent = "
+                "8 (a lump of about twice lump.diameter). A class "
+                "lump has the calibration's element size (its count follows its diameter) up to this cap; "
+                "a coarser class gets the cap and coarser elements, a bias bench/README.md measures (\"A "
+                "class lump at the element cap\"); raise it to keep the element size at more cost"),
+                1, false, 1000, false))};
 }
 
 // The calibration's virtual lab tests.
@@ -713,6 +726,8 @@ void table(std::ostringstream& o, const Schema& s) {
   o << "|---|---|---|---|---|---|\n";
   for (const auto& k : s.keys) {
     std::string def = k.default_yaml.empty() ? (k.optional ? "(optional)" : "(required)") : "`" + k.default_yaml + "`";
+    if (k.default_if)
+      def = "`" + k.default_if->yaml + "` with `" + k.default_if->when + ": " + k.default_if->is + "`, else " + def;
     o << "| `" << k.path << "` | " << type_name(k.type) << " | " << (k.unit.empty() ? "-" : k.unit) << " | "
       << def << " | " << expected_text(k) << " | " << k.doc << " |\n";
   }

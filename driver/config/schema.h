@@ -30,6 +30,14 @@ struct Plausible {
   std::vector<UnitSlip> slips;
 };
 
+// A default that depends on another key's value: `yaml` when the key `when`
+// has the value `is` (after its own default), else the key's default_yaml.
+struct DefaultIf {
+  std::string when;
+  std::string is;
+  std::string yaml;
+};
+
 // One declared key. `path` is dotted ("rotor.rpm"); `default_yaml` is the
 // default written as YAML ("" = required key, no default).
 struct KeyDef {
@@ -47,6 +55,7 @@ struct KeyDef {
   std::string pattern;               // String: ECMAScript regex the whole value must match
   std::string pattern_text;          // String: what the pattern admits, for messages and docs
   std::optional<Plausible> plausible;  // numbers: the range a real rock, gas or mill takes
+  std::optional<DefaultIf> default_if;  // a default that follows another key's value
 };
 
 // What a table describes: used in messages ("case file", "ore card").

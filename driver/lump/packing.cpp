@@ -54,6 +54,27 @@ double target_mean_radius(long n, double diameter, double spread) {
   return R * std::cbrt(phi / (static_cast<double>(n) * mean_cube_factor(spread)));
 }
 
+long elements_for_radius(double radius, double diameter, double spread) {
+  // target_mean_radius is R (0.62 / c)^(1/3) x (1 - 1.23 x), x = n^(-1/3):
+  // it falls with n from n = 15 on (x below 1 / 2.46), the packings the
+  // rule was fitted to. Bisect there for the last n whose radius is at
+  // least `radius`, then take the nearer of it and the next.
+  constexpr long kFirst = 15;
+  if (target_mean_radius(kFirst, diameter, spread) <= radius) return kFirst;
+  long lo = kFirst, hi = 2 * kFirst;
+  while (target_mean_radius(hi, diameter, spread) >= radius && hi < (1L << 40)) {
+    lo = hi;
+    hi *= 2;
+  }
+  while (hi - lo > 1) {
+    const long mid = lo + (hi - lo) / 2;
+    (target_mean_radius(mid, diameter, spread) >= radius ? lo : hi) = mid;
+  }
+  return target_mean_radius(lo, diameter, spread) - radius <= radius - target_mean_radius(hi, diameter, spread)
+             ? lo
+             : hi;
+}
+
 LumpInfo parse_lump_info(const fs::path& file) {
   std::ifstream in(file);
   std::string line;

@@ -58,6 +58,13 @@ long prime_stream(long seed);
 // (0.62 (1 - 1.23 N^(-1/3))^3, fitted to this builder; the rest follows).
 double target_mean_radius(long n, double diameter, double spread);
 
+// The element count whose target_mean_radius in a ball of `diameter` is
+// nearest `radius` (the inverse of the above: the solid fraction rises with
+// the count, so a lump of 8 x the elements in 2 x the diameter has slightly
+// larger elements, and one of the same element size slightly more of them).
+// At least 15: below it the rule's radius no longer falls with the count.
+long elements_for_radius(double radius, double diameter, double spread);
+
 // What decides one ball packing.
 struct BallPacking {
   long n_elements = 0;

@@ -279,3 +279,33 @@ TEST(CaseFile, AdaptiveStepIsTheDefaultWithTheAutomaticStep) {
                mill::config::ConfigError);
   EXPECT_NO_THROW(load_case(f, kProject, {{"breakage.adaptive_step", "false"}}));
 }
+
+// breakage.in_mill.lumps follows breakage.conditions when absent: 4 with
+// transport (a band for the product and the decision), 0 with a sweep (in-mill
+// lumps need stage 1's strikes); a given value stands either way, and the
+// default taken is a default (line 0). The table names both.
+TEST(CaseFile, InMillLumpsDefaultFollowsTheConditions) {
+  const mill::test::TempDir dir("mill_in_mill_default_" + std::to_string(getpid()));
+  struct {
+    const char *text;
+    long lumps;
+    int line;
+  } cases[] = {{"name: a\n", 0, 0},
+               {"name: b\nbreakage:\n  conditions: sweep\n", 0, 0},
+               {"name: c\nbreakage:\n  conditions: transport\n", 4, 0},
+               {"name: d\nbreakage:\n  conditions: transport\n  in_mill: {lumps: 0}\n", 0, 4},
+               {"name: e\nbreakage:\n  conditions: transport\n  in_mill: {lumps: 7}\n", 7, 4}};
+  for (const auto &c : cases) {
+    const fs::path f = dir / "case.yaml";
+    std::ofstream(f) << c.text;
+    const auto cfg = load_case(f, kProject);
+    EXPECT_EQ(cfg.doc.integer("breakage.in_mill.lumps"), c.lumps) << c.text;
+    EXPECT_EQ(cfg.doc.line("breakage.in_mill.lumps"), c.line) << c.text;
+  }
+  // Set by an override of the conditions, the default follows it too.
+  const fs::path f = dir / "case.yaml";
+  std::ofstream(f) << "name: f\n";
+  EXPECT_EQ(load_case(f, kProject, {{"breakage.conditions", "transport"}}).doc.integer("breakage.in_mill.lumps"), 4);
+  const std::string md = mill::config::schema_markdown();
+  EXPECT_NE(md.find("| `4` with `breakage.conditions: transport`, else `0` |"), std::string::npos);
+}

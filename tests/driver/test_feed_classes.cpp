@@ -7,6 +7,7 @@
 
 #include "config/case_config.h"
 #include "config/feed_classes.h"
+#include "lump/packing.h"
 
 using mill::config::case_schema;
 using mill::config::Document;
@@ -72,32 +73,57 @@ TEST(FeedClasses, RunsForEveryFedClassThatTheTransportTakes) {
 
 TEST(FeedClasses, ElementCountKeepsTheCalibratedElementSize) {
   const auto p = plan(kSixClasses);
-  // n = 3344 (d / 40 mm)^3, rounded: the element size of lump.diameter's lump.
-  for (size_t i : {0u, 1u, 2u}) {
-    const double ratio = p[i].diameter_m / 0.04;
-    EXPECT_EQ(p[i].n_elements, std::lround(3344 * ratio * ratio * ratio)) << i;
+  // The count whose mean element radius is that of lump.diameter's lump
+  // (3344 elements of 40 mm): within half a count's step of it, and more
+  // than the cube rule 3344 (d / 40 mm)^3 gives for the coarser 44.5 mm
+  // class (4619), fewer for the finer 22.3 mm one (579: the solid fraction
+  // rises with the count).
+  const double r_cal = mill::target_mean_radius(3344, 0.04, 0.25);
+  for (size_t i : {0u, 1u}) {
+    const double d = p[i].diameter_m;
+    const long n = p[i].n_elements;
+    const double r = mill::target_mean_radius(n, d, 0.25);
+    EXPECT_NEAR(p[i].element_size, r / r_cal, 1e-15) << i;
+    EXPECT_LE(std::abs(r - r_cal), std::abs(mill::target_mean_radius(n + 1, d, 0.25) - r_cal)) << i;
+    EXPECT_LE(std::abs(r - r_cal), std::abs(mill::target_mean_radius(n - 1, d, 0.25) - r_cal)) << i;
     EXPECT_NEAR(p[i].element_size, 1.0, 2e-3) << i;  // rounding of the count only
   }
-  EXPECT_EQ(p[0].n_elements, 4619);  // 44.5 mm
-  EXPECT_EQ(p[2].n_elements, 76);    // 11.3 mm
+  EXPECT_GT(p[0].n_elements, 4619);
+  EXPECT_LT(p[1].n_elements, 579);
+  // The 11.3 mm class: the calibration's elements would fill it with fewer
+  // than 15, where the packing rule's radius stops falling with the count;
+  // it gets 15, a little finer than the calibration's.
+  EXPECT_EQ(p[2].n_elements, 15);
+  EXPECT_LT(p[2].element_size, 1.0);
+  EXPECT_GT(p[2].element_size, 0.9);
 }
 
 TEST(FeedClasses, ElementCountIsCappedAndFloored) {
-  // A 10 mm, 100-element lump: the 44.5 mm class would need 8840 elements;
-  // it gets the cap, 8 x 100, and elements 4.45 / 2 = 2.23 times as large.
+  // A 10 mm, 100-element lump: the 44.5 mm class would need about 10 000
+  // elements; it gets the cap, 8 x 100, and its elements are that many
+  // times the calibration's: the ratio of the two lumps' mean radii.
   auto text = kSixClasses;
   text.replace(text.find("{n_elements: 3344, diameter: 0.04}"), 34,
                "{n_elements: 100, diameter: 0.01}");
   auto p = plan(text);
   EXPECT_EQ(p[0].n_elements, 800);
-  EXPECT_NEAR(p[0].element_size, (p[0].diameter_m / 0.01) / 2, 1e-12);
-  // A 10-element lump of 40 mm: the 11.3 mm class gets the fewest a lump
-  // may have (10), finer elements than the calibration's.
-  text = kSixClasses;
-  text.replace(text.find("n_elements: 3344"), 16, "n_elements: 10");
+  EXPECT_NEAR(p[0].element_size,
+              mill::target_mean_radius(800, p[0].diameter_m, 0.25) / mill::target_mean_radius(100, 0.01, 0.25),
+              1e-12);
+  EXPECT_GT(p[0].element_size, 2.0);
+  // feed.class_element_cap lifts the cap: the element size is kept.
+  text += "  class_element_cap: 200\n";
   p = plan(text);
-  EXPECT_EQ(p[2].n_elements, 10);
-  EXPECT_LT(p[2].element_size, 1.0);
+  EXPECT_GT(p[0].n_elements, 9000);
+  EXPECT_LT(p[0].n_elements, 20000);
+  EXPECT_NEAR(p[0].element_size, 1.0, 1e-3);
+  // A 20-element lump of 40 mm: the 11.3 mm class gets the fewest the
+  // packing rule gives (15), much finer elements than the calibration's.
+  text = kSixClasses;
+  text.replace(text.find("n_elements: 3344"), 16, "n_elements: 20");
+  p = plan(text);
+  EXPECT_EQ(p[2].n_elements, 15);
+  EXPECT_LT(p[2].element_size, 0.5);
 }
 
 TEST(FeedClasses, WithoutInMillLumpsOnlyTheTransportRuns) {

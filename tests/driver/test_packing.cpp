@@ -99,3 +99,31 @@ TEST(Packing, RadiusClassesAndMeanRadius) {
   const double solid = n * rm * rm * rm * mean_cube_factor(0.25) / std::pow(d / 2, 3);
   EXPECT_NEAR(solid, 0.62 * std::pow(1 - 1.23 * std::pow(n, -1.0 / 3), 3), 1e-12);
 }
+
+// elements_for_radius inverts target_mean_radius: the count it gives has
+// the radius nearest the one asked for (its neighbours are no nearer), a
+// count's own radius gives it back, and a lump of 8 x the elements in twice
+// the diameter has larger elements (the solid fraction rises with the
+// count), so the same element size takes more than 8 x (hand check: 2000
+// elements of 40 mm have r = 20 mm x (0.62 (1 - 1.23 / 2000^(1/3))^3 /
+// (2000 c))^(1/3); the 80 mm ball needs about 2000 x 8 x (0.9024/0.9512)^-3).
+TEST(Packing, ElementsForRadiusInvertsTheMeanRadius) {
+  for (long n : {15L, 16L, 100L, 250L, 1668L, 2000L, 3344L, 100000L})
+    EXPECT_EQ(elements_for_radius(target_mean_radius(n, 0.04, 0.25), 0.04, 0.25), n) << n;
+  const double r = target_mean_radius(2000, 0.04, 0.25);
+  for (double d : {0.01, 0.0266, 0.0376, 0.0532, 0.08}) {
+    const long n = elements_for_radius(r, d, 0.25);
+    const double miss = std::abs(target_mean_radius(n, d, 0.25) - r);
+    EXPECT_LE(miss, std::abs(target_mean_radius(n - 1, d, 0.25) - r)) << d;
+    EXPECT_LE(miss, std::abs(target_mean_radius(n + 1, d, 0.25) - r)) << d;
+  }
+  const double x2000 = 1 - 1.23 * std::pow(2000.0, -1.0 / 3), x16000 = 1 - 1.23 * std::pow(16000.0, -1.0 / 3);
+  EXPECT_GT(target_mean_radius(16000, 0.08, 0.25), r);
+  EXPECT_NEAR(target_mean_radius(16000, 0.08, 0.25) / r, x16000 / x2000, 1e-12);
+  const long n80 = elements_for_radius(r, 0.08, 0.25);
+  EXPECT_GT(n80, 16000);
+  EXPECT_NEAR(static_cast<double>(n80), 16000 * std::pow(x16000 / x2000, 3), 0.02 * 16000);
+  // Below 15 elements the rule's radius no longer falls with the count:
+  // a radius larger than 15 elements' gives 15.
+  EXPECT_EQ(elements_for_radius(target_mean_radius(15, 0.04, 0.25) * 1.5, 0.04, 0.25), 15);
+}

@@ -119,6 +119,9 @@ std::map<double, post::AssembledMatrix> write_breakage_matrices(StageContext& ct
         col["lump_mass_kg"] = r.mass_kg;
         col["lump_diameter_mm"] = r.lump_mm;
         col["lump_elements"] = r.elements;
+        // Its mean element radius over the calibration's: 1 to the count's
+        // rounding, above 1 for a class lump at feed.class_element_cap.
+        if (r.own) col["element_size_vs_calibration"] = plan[j].element_size;
         col["runs"] = r.own ? "the class's own (its representative size)" : "lump.diameter's";
         measured_text += fmt::format("{}{} ({} lump(s) of {:.4g} mm, {:.1f}% stays)",
                                      measured_text.empty() ? "" : ", ", classes.name(j),
