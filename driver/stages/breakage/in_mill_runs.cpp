@@ -151,8 +151,15 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan,
     base["feed_class"] = cls->cls;
   }
   const std::string prefix = cls ? fmt::format("{}_c{}", rpm_label(rpm), cls->cls) : rpm_label(rpm);
-  const std::string lumps = cls ? fmt::format(" feed {}, {:.4g} mm lump of {} elements:", cls->name,
-                                              1e3 * cls->diameter_m, cls->n_elements)
+  // A class lump off the calibration's element size (at feed.class_element_cap,
+  // or the packing's fewest) says so in its plan line.
+  const std::string off_size =
+      cls && std::abs(cls->element_size - 1) > 0.01
+          ? fmt::format(" (elements {:.2f} x the calibration's{})", cls->element_size,
+                        cls->element_size > 1 ? ": feed.class_element_cap" : "")
+          : std::string();
+  const std::string lumps = cls ? fmt::format(" feed {}, {:.4g} mm lump of {} elements{}:", cls->name,
+                                              1e3 * cls->diameter_m, cls->n_elements, off_size)
                                 : std::string(":");
   for (size_t i = 0; i < starts.size(); ++i) {
     const auto& s = starts[i];
