@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "config/case_config.h"
 #include "lump/packing.h"
@@ -57,8 +58,8 @@ std::vector<FeedClassRuns> plan_feed_classes(const Document& d, const Feed& f) {
   const double spread = d.real("lump.radius_spread");
   // The calibration's element size: the mean element radius of lump.diameter's lump.
   const double r_cal = target_mean_radius(n_ref, d.real("lump.diameter"), spread);
-  const long cap =
-      (d.has("feed.class_element_cap") ? d.integer("feed.class_element_cap") : kFeedClassElementCap) * n_ref;
+  const long cap = d.has("feed.class_element_cap") ? d.integer("feed.class_element_cap") * n_ref
+                                                   : std::numeric_limits<long>::max();
   std::vector<FeedClassRuns> out;
   for (std::size_t i = 0; i < n; ++i) {
     FeedClassRuns r;

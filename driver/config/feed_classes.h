@@ -2,7 +2,7 @@
 // size class"): which classes of feed.sizes_mm get a transport run (stage 1)
 // of their own and in-mill breakage runs of their own, the diameter of their
 // lumps (the class's representative size) and the element count of their
-// bonded lump (the calibration's element size where the cap allows). A class
+// bonded lump (the calibration's element size unless the case caps it). A class
 // without runs says why; its breakage column is then scaled from a measured
 // one. Planned from the case alone: the transport and breakage stages both
 // call it and get the same classes.
@@ -21,12 +21,6 @@ class Document;
 // A class with less than this share of the feed has no runs of its own
 // (a table's zeros; a Rosin-Rammler feed's far tails).
 inline constexpr double kFeedClassMinFraction = 1e-3;
-// A class lump has at most this many times lump.n_elements when the case
-// does not set feed.class_element_cap (a lump of about twice lump.diameter
-// at the calibration's element size); coarser classes get the cap and
-// coarser elements.
-inline constexpr long kFeedClassElementCap = 8;
-
 struct FeedClassRuns {
   std::size_t cls = 0;       // class index, coarsest first (post::SizeClassesFromSieves)
   std::string name;          // "16-22.4 mm"
@@ -51,7 +45,10 @@ struct FeedClassRuns {
 // - the in-mill lump's elements: the count whose mean element radius
 //   (target_mean_radius) is that of lump.diameter's lump, for which the
 //   calibration was made (elements_for_radius), at least kMinLumpElements
-//   and at most feed.class_element_cap x lump.n_elements.
+//   and, when the case sets feed.class_element_cap, at most that many
+//   times lump.n_elements (coarser elements than the calibration's, which
+//   bias the class's breakage: bench/README.md, "A class lump at the
+//   element cap"); no cap otherwise.
 std::vector<FeedClassRuns> plan_feed_classes(const Document& d, const Feed& f);
 
 }  // namespace mill::config

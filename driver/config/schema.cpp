@@ -477,11 +477,12 @@ std::vector<KeyDef> feed_keys() {
                        "Feed: the product P80 wanted (optional); at or above the finest sieve and below "
                        "feed.cut_size_mm"))),
       opt(range(key("feed.class_element_cap", T::Int, "", "",
-                "Feed: most elements of a class's in-mill lump, as a multiple of lump.n_elements; absent = "
-                "8 (a lump of about twice lump.diameter). A class "
-                "lump has the calibration's element size (its count follows its diameter) up to this cap; "
-                "a coarser class gets the cap and coarser elements, a bias bench/README.md measures (\"A "
-                "class lump at the element cap\"); raise it to keep the element size at more cost"),
+                    "Feed: most elements of a class's in-mill lump, as a multiple of lump.n_elements; absent = "
+                    "no cap. A class lump has the calibration's element size, so its count follows its "
+                    "diameter (a class of twice lump.diameter: about 8 x); a cap saves time on coarse classes "
+                    "but gives them coarser elements, and a shattered lump's product is mostly single "
+                    "elements, so their product is coarser in proportion (bench/README.md, \"A class lump "
+                    "at the element cap\": P80 1.5 x at 1.5 x the element size)"),
                 1, false, 1000, false))};
 }
 

@@ -98,25 +98,25 @@ TEST(FeedClasses, ElementCountKeepsTheCalibratedElementSize) {
   EXPECT_GT(p[2].element_size, 0.9);
 }
 
-TEST(FeedClasses, ElementCountIsCappedAndFloored) {
-  // A 10 mm, 100-element lump: the 44.5 mm class would need about 10 000
-  // elements; it gets the cap, 8 x 100, and its elements are that many
-  // times the calibration's: the ratio of the two lumps' mean radii.
+TEST(FeedClasses, ElementCountIsCappedOnlyWhenTheCaseAsksAndFloored) {
+  // A 10 mm, 100-element lump: the 44.5 mm class keeps the calibration's
+  // element size with about 10 000 elements (no cap by default) ...
   auto text = kSixClasses;
   text.replace(text.find("{n_elements: 3344, diameter: 0.04}"), 34,
                "{n_elements: 100, diameter: 0.01}");
   auto p = plan(text);
+  EXPECT_GT(p[0].n_elements, 9000);
+  EXPECT_LT(p[0].n_elements, 20000);
+  EXPECT_NEAR(p[0].element_size, 1.0, 1e-3);
+  // ... and with feed.class_element_cap 8 it gets 8 x 100 and elements that
+  // many times the calibration's: the ratio of the two lumps' mean radii.
+  text += "  class_element_cap: 8\n";
+  p = plan(text);
   EXPECT_EQ(p[0].n_elements, 800);
   EXPECT_NEAR(p[0].element_size,
               mill::target_mean_radius(800, p[0].diameter_m, 0.25) / mill::target_mean_radius(100, 0.01, 0.25),
               1e-12);
   EXPECT_GT(p[0].element_size, 2.0);
-  // feed.class_element_cap lifts the cap: the element size is kept.
-  text += "  class_element_cap: 200\n";
-  p = plan(text);
-  EXPECT_GT(p[0].n_elements, 9000);
-  EXPECT_LT(p[0].n_elements, 20000);
-  EXPECT_NEAR(p[0].element_size, 1.0, 1e-3);
   // A 20-element lump of 40 mm: the 11.3 mm class gets the fewest the
   // packing rule gives (15), much finer elements than the calibration's.
   text = kSixClasses;

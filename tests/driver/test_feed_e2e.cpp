@@ -30,9 +30,11 @@ const std::vector<double> kRpm = {2000, 2500};
 
 // The feed classes of tiny_feed.yaml that are fed: class 0 (22.4-31.5 mm)
 // and class 1 (16-22.4 mm), their representative sizes (mm) and the
-// elements of their lumps, 40 x (size / 20 mm)^3 rounded.
+// elements of their lumps: the counts whose mean element radius is the
+// 40-element 20 mm lump's (mill::elements_for_radius; the cube rule
+// 40 x (size / 20 mm)^3 would give 94 and 34 elements of other sizes).
 const std::vector<double> kClassMm = {std::sqrt(22.4 * 31.5), std::sqrt(16 * 22.4)};
-const std::vector<long> kClassElements = {94, 34};
+const std::vector<long> kClassElements = {167, 25};
 
 // Per rotor speed, one lump falling at 5 m/s onto plate 0's leading face
 // (x = -0.01 m), which points up at t = (pi/2) / omega (as in

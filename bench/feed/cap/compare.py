@@ -3,8 +3,9 @@
 (bench/feed/cap/run.sh): per run, the 45-63 mm class's measured breakage
 column (where its mass goes in one pass), the steady product's P80 and
 circulating load with their bootstrap bands, and the in-mill lumps' pieces."""
-import csv
+import glob
 import json
+import os
 import sys
 
 
@@ -22,6 +23,7 @@ def column(m, j):
 
 def main():
     runs = sys.argv[1:3]
+    names = [r.rstrip("/").split("/")[-1] for r in runs]
     data = [load(r) for r in runs]
     classes = data[0][0]["classes"]
     j = next(k for k, c in enumerate(data[0][0]["rotor_speeds"][0]["columns"])
@@ -54,19 +56,22 @@ def main():
         print(f"| {label} | " + " | ".join(cells) + " |")
 
 
-    # The same strikes in both runs (the transport is shared): the lumps
-    # paired by particle id, the mean of each figure and the paired
-    # difference with its standard error over the pairs.
+    # The same strikes in both runs (the transport is shared): the class's
+    # in-mill jobs paired by label (rotor speed, class, stage-1 lump id),
+    # the mean of each figure and the paired difference with its standard
+    # error over the pairs.
     lumps = []
     for r in runs:
-        with open(f"{r}/breakage/in_mill.csv") as f:
-            lumps.append({(row["rpm"], row["particle_id"]): row for row in csv.DictReader(f) if f"_c{j}_" in row["label"]})
-    ids = sorted(set(lumps[0]) & set(lumps[1]), key=lambda k: (float(k[0]), int(k[1])))
-    print(f"\nper lump, {len(ids)} strikes paired by particle id (mean; paired difference uncapped - capped +- standard error):")
-    print("| figure | " + " | ".join(r.rstrip("/").split("/")[-1] for r in runs) + " | difference |")
+        jobs = {}
+        for f in sorted(glob.glob(f"{r}/breakage/jobs/rpm*_c{j}_mill_p*/in_mill.json")):
+            jobs[os.path.basename(os.path.dirname(f))] = json.load(open(f))
+        lumps.append(jobs)
+    ids = sorted(set(lumps[0]) & set(lumps[1]))
+    print(f"\nper lump, {len(ids)} strikes paired (mean; paired difference {names[1]} - {names[0]} +- standard error):")
+    print("| figure | " + " | ".join(names) + " | difference |")
     print("|---|---|---|---|")
-    for key in ("strike_speed_m_s", "largest_mass_fraction", "single_mass_fraction", "t10_percent",
-                "broken_bond_fraction", "n_pieces", "wall_seconds"):
+    for key in ("velocity_m_s", "largest_mass_fraction", "single_mass_fraction", "t10_percent",
+                "broken_bond_fraction", "n_pieces", "specific_energy_J_kg", "wall_seconds"):
         a = [float(lumps[0][i][key]) for i in ids]
         b = [float(lumps[1][i][key]) for i in ids]
         d = [y - x for x, y in zip(a, b)]
