@@ -482,7 +482,7 @@ std::vector<KeyDef> feed_keys() {
                     "diameter (a class of twice lump.diameter: about 8 x); a cap saves time on coarse classes "
                     "but gives them coarser elements, and a shattered lump's product is mostly single "
                     "elements, so their product is coarser in proportion (bench/README.md, \"A class lump "
-                    "at the element cap\": P80 1.5 x at 1.5 x the element size)"),
+                    "at the element cap\": elements 1.53 x the calibration's gave a 6.82 mm P80 against 4.36 mm)"),
                 1, false, 1000, false))};
 }
 

@@ -3,8 +3,9 @@
 # at the element cap"). Two cases that differ only in feed.class_element_cap:
 # one 45-63 mm feed class (53 mm lumps) through the default mill at 1500 rpm
 # with 8 in-mill lumps, the case's lump 20 mm of 156 elements (the default
-# lump's element size); capped: the class lump gets 8 x 156 = 1248 elements
-# (1.53 x the calibration's element size), uncapped: its 5143. The two share
+# lump's element size); capped (feed.class_element_cap 8): the class lump
+# gets 8 x 156 = 1248 elements (1.53 x the calibration's element size),
+# uncapped (no cap, the default): its 5134. The two share
 # the calibration (the same key), the flow and the transport (the same
 # strikes), so what differs is the class lump's resolution. Prints the
 # class's measured breakage column, the product and the decision of each,
