@@ -276,7 +276,7 @@ void circuit_json(const fs::path& run, Problems* problems, json& h) {
         {"steady", pick(e, "steady")},
         {"finest_sieve_mm", sieves.is_array() && !sieves.empty() ? sieves[0] : json(nullptr)}};
     for (const char* k : {"p50_mm", "p80_mm", "circulating_load", "mass_balance_residual",
-                          "product_total_t_h", "problem"})
+                          "product_total_t_h", "problem", "p80_set_by_elements"})
       if (e.contains(k)) x[k] = e.at(k);
     for (const char* k :
          {"specific_energy_kWh_t", "ore_power_W", "gas_shaft_power_W", "passes_per_tonne"})
@@ -287,6 +287,10 @@ void circuit_json(const fs::path& run, Problems* problems, json& h) {
     }
     h["circuit"][fmt::format("rpm{:g}", d(e.at("rpm")))] = x;
   }
+  // The finest size the lumps resolve: one element.
+  const json res = pick(pick(c, "resolution"), "element_piece_mm");
+  if (num(pick(res, "smallest")) && num(pick(res, "largest")))
+    h["circuit_resolution"] = {{"element_piece_mm", {res.at("smallest"), res.at("largest")}}};
   // With feed.target_p80_mm: the lowest rotor speed that meets it.
   const json dec = pick(c, "decision");
   if (dec.is_object())
@@ -594,6 +598,21 @@ void circuit_rows(const json& h, const RowAdder& add) {
                     g3(d(dec.at("target_p80_mm")))),
         dec.at("sentence").get<std::string>());
   const json circ = pick(h, "circuit");
+  // The finest size the lumps resolve, and the speeds whose P80 it sets.
+  const json span = pick(pick(h, "circuit_resolution"), "element_piece_mm");
+  if (span.is_array() && span.size() == 2 && num(span[0]) && num(span[1])) {
+    std::string bound;
+    for (const auto& rpm : rpm_keys(circ))
+      if (pick(circ.at(rpm), "p80_set_by_elements").is_boolean() && circ.at(rpm).at("p80_set_by_elements").get<bool>())
+        bound += (bound.empty() ? "" : ", ") + rpm_words(rpm);
+    add(5, "finest size the lumps resolve",
+        fmt::format("one element, {}-{} mm{}", g3(d(span[0])), g3(d(span[1])),
+                    bound.empty() ? std::string()
+                                  : "; the P80 at " + bound +
+                                        " is within 2 x of it, so it follows the element size (the "
+                                        "calibration's), not the rock (bench/README.md, \"A class lump at "
+                                        "the element cap\")"));
+  }
   for (const auto& rpm : rpm_keys(circ)) {
     const json& c = circ.at(rpm);
     const std::string at = ", " + rpm_words(rpm);

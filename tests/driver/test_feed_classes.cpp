@@ -8,6 +8,7 @@
 #include "config/case_config.h"
 #include "config/feed_classes.h"
 #include "lump/packing.h"
+#include "stages/breakage/circuit.h"
 
 using mill::config::case_schema;
 using mill::config::Document;
@@ -171,3 +172,26 @@ TEST(FeedClasses, ALumpThatDoesNotPassTheInletHasNoRuns) {
 }
 
 }  // namespace
+
+// The element pieces of a lump (stages/breakage/circuit.h): a piece of one
+// element of mass share m/M takes lump_mm x (m/M)^(1/3); the radius classes
+// r (1 + 0.25 {-1, ..., 1}) have mass shares (1 + s)^3 / (c n), c the mean
+// of the cubes (1.09375 at spread 0.25, by hand: (0.421875 + 0.669921875 +
+// 1 + 1.423828125 + 1.953125) / 5), and the mean-mass piece is lump_mm / n^(1/3).
+TEST(ElementPieces, OneElementsPieceSizesByHand) {
+  const double c = (0.421875 + 0.669921875 + 1 + 1.423828125 + 1.953125) / 5;
+  EXPECT_DOUBLE_EQ(c, 1.09375);
+  const auto e = mill::breakage::element_piece_mm(53.24, 5134, 0.25);
+  EXPECT_NEAR(e.mean_mm, 53.24 / std::cbrt(5134.0), 1e-12);
+  EXPECT_NEAR(e.smallest_mm, 53.24 * std::cbrt(0.421875 / (c * 5134)), 1e-12);
+  EXPECT_NEAR(e.largest_mm, 53.24 * std::cbrt(1.953125 / (c * 5134)), 1e-12);
+  // The bench's two lumps (bench/README.md, "A class lump at the element
+  // cap"): the mean pieces 3.08 and 4.94 mm, 1.60 x apart for 4.1 x the
+  // elements.
+  EXPECT_NEAR(e.mean_mm, 3.08, 0.01);
+  EXPECT_NEAR(mill::breakage::element_piece_mm(53.24, 1248, 0.25).mean_mm, 4.94, 0.01);
+  // Without spread every piece is the mean one.
+  const auto u = mill::breakage::element_piece_mm(40, 2000, 0);
+  EXPECT_DOUBLE_EQ(u.smallest_mm, u.largest_mm);
+  EXPECT_NEAR(u.mean_mm, 40 / std::cbrt(2000.0), 1e-12);
+}

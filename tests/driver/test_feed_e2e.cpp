@@ -12,11 +12,13 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "e2e_util.h"
 #include "postprocess/breakage_results.h"
+#include "stages/breakage/circuit.h"
 
 namespace fs = std::filesystem;
 
@@ -217,6 +219,23 @@ TEST_F(Feed, ClosedCircuitPerRotorSpeedWithProductP80LoadAndResidual) {
     const double b00 = m.at("rotor_speeds")[k].at("matrix")[0][0].get<double>();
     EXPECT_NEAR(e.at("mill_input_t_h")[7].get<double>(), 8.0 / (1.0 - b00), 1e-9);
   }
+  // The finest size the lumps resolve: the element pieces of the two
+  // classes' lumps (their diameters and counts), and per speed whether the
+  // P80 is within 2 x of the largest.
+  const json& res = c.at("resolution");
+  ASSERT_EQ(res.at("classes").size(), 2u) << res.dump(2);
+  double largest = 0;
+  for (size_t k = 0; k < 2; ++k) {
+    const json& r = res.at("classes")[k];
+    EXPECT_EQ(r.at("lump_elements").get<long>(), kClassElements[k]);
+    const auto e = mill::breakage::element_piece_mm(kClassMm[k], kClassElements[k], 0.25);
+    EXPECT_NEAR(r.at("largest_mm").get<double>(), e.largest_mm, 1e-9);
+    EXPECT_NEAR(r.at("smallest_mm").get<double>(), e.smallest_mm, 1e-9);
+    largest = std::max(largest, e.largest_mm);
+  }
+  EXPECT_NEAR(res.at("element_piece_mm").at("largest").get<double>(), largest, 1e-9);
+  for (const json& e : c.at("rotor_speeds"))
+    EXPECT_EQ(e.at("p80_set_by_elements").get<bool>(), e.at("p80_mm").get<double>() < 2 * largest) << e.dump();
   EXPECT_NE(slurp(stage() / "circuit.csv")
                 .find("rpm,class,lower_mm,upper_mm,feed_t_h,mill_input_t_h,returned_t_h,"
                       "product_t_h,product_passing_percent"),

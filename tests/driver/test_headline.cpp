@@ -237,4 +237,29 @@ TEST(Headline, ClosedCircuitEnergyAndDecisionWithItsKWhPerTonne) {
             "2.75 kWh/t (gas shaft 30 kW + ore 25 kW, 1.8 passes per tonne)");
 }
 
+// The finest size the lumps resolve, one element, and the speeds whose P80
+// lies within 2 x of it (circuit.json's resolution, p80_set_by_elements).
+TEST(Headline, ClosedCircuitNamesThePeightyTheElementsSet) {
+  namespace fs = std::filesystem;
+  const mill::test::TempDir run("mill_headline_resolution_" + std::to_string(getpid()));
+  fs::create_directories(run / "breakage");
+  std::ofstream(run / "breakage/circuit.json") << R"({"sieves_mm": [2, 4, 8],
+      "rotor_speeds": [{"rpm": 1500, "steady": true, "p50_mm": 5.1, "p80_mm": 9.2, "p80_set_by_elements": false},
+                       {"rpm": 2000, "steady": true, "p50_mm": 3.1, "p80_mm": 4.1, "p80_set_by_elements": true}],
+      "resolution": {"element_piece_mm": {"smallest": 2.31, "largest": 3.84}}})";
+  const json h = mill::report::headline_json(run);
+  EXPECT_EQ(h.at("circuit_resolution").at("element_piece_mm"), json::parse("[2.31, 3.84]"));
+  const auto rows = headline_rows(h);
+  EXPECT_EQ(value_of(rows, "finest size the lumps resolve"),
+            "one element, 2.31-3.84 mm; the P80 at 2000 rpm is within 2 x of it, so it follows the "
+            "element size (the calibration's), not the rock (bench/README.md, \"A class lump at the "
+            "element cap\")");
+  // No speed bound by it: the span alone.
+  std::ofstream(run / "breakage/circuit.json") << R"({"sieves_mm": [2, 4, 8],
+      "rotor_speeds": [{"rpm": 1500, "steady": true, "p50_mm": 5.1, "p80_mm": 9.2, "p80_set_by_elements": false}],
+      "resolution": {"element_piece_mm": {"smallest": 2.31, "largest": 3.84}}})";
+  EXPECT_EQ(value_of(headline_rows(mill::report::headline_json(run)), "finest size the lumps resolve"),
+            "one element, 2.31-3.84 mm");
+}
+
 }  // namespace

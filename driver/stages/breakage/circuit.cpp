@@ -8,6 +8,7 @@
 
 #include "engine/runner.h"
 #include "jobs/job_store.h"
+#include "lump/packing.h"
 #include "postprocess/circuit_bootstrap.h"
 #include "postprocess/fragments.h"
 #include "progress.h"
@@ -133,6 +134,51 @@ std::string mm_or_finer(const nlohmann::json& v, double finest) {
 
 }  // namespace
 
+ElementPieces element_piece_mm(double lump_mm, long elements, double spread) {
+  // Element class k has the mass share (1 + s_k)^3 / (c n) of the lump, c the
+  // mean of the cubes (mill::mean_cube_factor): its piece is lump_mm times
+  // the cube root of that.
+  const double per = lump_mm / std::cbrt(mean_cube_factor(spread) * static_cast<double>(elements));
+  return {per * class_factor(0, spread), per * std::cbrt(mean_cube_factor(spread)),
+          per * class_factor(4, spread)};
+}
+
+namespace {
+
+// circuit.json's "resolution": the element pieces of every measured class's
+// lumps (the same lumps at every speed: the first speed's).
+nlohmann::json resolution_json(const MeasuringRuns& runs, double spread, double* largest_mm) {
+  nlohmann::json classes = nlohmann::json::array();
+  double lo = INFINITY, hi = 0;
+  if (!runs.empty())
+    for (const auto& [cls, r] : runs.begin()->second) {
+      if (r.elements <= 0 || !(r.lump_mm > 0)) continue;
+      const ElementPieces e = element_piece_mm(r.lump_mm, r.elements, spread);
+      classes.push_back({{"class", cls},
+                         {"lump_mm", r.lump_mm},
+                         {"lump_elements", r.elements},
+                         {"smallest_mm", e.smallest_mm},
+                         {"mean_mm", e.mean_mm},
+                         {"largest_mm", e.largest_mm}});
+      lo = std::min(lo, e.smallest_mm);
+      hi = std::max(hi, e.largest_mm);
+    }
+  *largest_mm = hi;
+  if (classes.empty()) return nullptr;
+  return {{"element_piece_mm", {{"smallest", lo}, {"largest", hi}}},
+          {"classes", classes},
+          {"p80_bound_factor", kElementBoundP80Factor},
+          {"definition",
+           "a piece of one element cannot break further: element_piece_mm spans the sizes such a piece "
+           "takes (lump diameter x (element mass / lump mass)^(1/3), the smallest to the largest "
+           "radius class of the measured classes' lumps). A shattered lump's mass sits there, so a "
+           "P80 below p80_bound_factor x the largest is set by the element size, not by the rock "
+           "(rotor_speeds[].p80_set_by_elements; bench/README.md, \"A class lump at the element "
+           "cap\")"}};
+}
+
+}  // namespace
+
 void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatrix>& matrices,
                    const MeasuringRuns& runs,
                    const std::map<double, std::optional<double>>& gas_W) {
@@ -205,6 +251,20 @@ void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatr
         mm_or_finer(e["p50_mm"], feed.sizes_mm.front()), s.circulating_load,
         s.mass_balance_residual));
   }
+  // The finest size the lumps resolve, and which P80 it sets.
+  double largest_piece = 0;
+  const nlohmann::json resolution =
+      resolution_json(runs, ctx.cfg.doc.real("lump.radius_spread"), &largest_piece);
+  for (auto& e : speeds)
+    if (largest_piece > 0 && e.contains("p80_mm") && e.at("p80_mm").is_number()) {
+      e["p80_set_by_elements"] = e.at("p80_mm").get<double>() < kElementBoundP80Factor * largest_piece;
+      if (e["p80_set_by_elements"].get<bool>())
+        ctx.progress.warn(fmt::format(
+            "[breakage] closed circuit at {:g} rpm: P80 {:.3g} mm is below {:g} x the largest element's "
+            "piece ({:.3g} mm): the product's fine end is the elements' size, not the rock's "
+            "(bench/README.md, \"A class lump at the element cap\")",
+            e.at("rpm").get<double>(), e.at("p80_mm").get<double>(), kElementBoundP80Factor, largest_piece));
+    }
   // The band the lumps give: the bootstrap over each class's lumps.
   const std::vector<post::SpeedLumps> lumps = speed_lumps(runs, gas_W);
   bool with_gas = true;
@@ -231,6 +291,7 @@ void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatr
       {"classification_returned", ascending(c)},
       {"rotor_speeds", speeds},
       {"bootstrap", bootstrap_json(band)},
+      {"resolution", resolution},
       {"units",
        {{"*_t_h", "t/h"},
         {"*_mm", "mm"},
