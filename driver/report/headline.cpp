@@ -601,17 +601,20 @@ void circuit_rows(const json& h, const RowAdder& add) {
   // The finest size the lumps resolve, and the speeds whose P80 it sets.
   const json span = pick(pick(h, "circuit_resolution"), "element_piece_mm");
   if (span.is_array() && span.size() == 2 && num(span[0]) && num(span[1])) {
-    std::string bound;
+    std::vector<std::string> at;
     for (const auto& rpm : rpm_keys(circ))
       if (pick(circ.at(rpm), "p80_set_by_elements").is_boolean() && circ.at(rpm).at("p80_set_by_elements").get<bool>())
-        bound += (bound.empty() ? "" : ", ") + rpm_words(rpm);
+        at.push_back(rpm.substr(3));
+    std::string bound;
+    for (size_t i = 0; i < at.size(); ++i)
+      bound += (i == 0 ? "" : i + 1 == at.size() ? " and " : ", ") + at[i];
+    if (!bound.empty()) bound += " rpm";
     add(5, "finest size the lumps resolve",
         fmt::format("one element, {}-{} mm{}", g3(d(span[0])), g3(d(span[1])),
                     bound.empty() ? std::string()
                                   : "; the P80 at " + bound +
-                                        " is within 2 x of it, so it follows the element size (the "
-                                        "calibration's), not the rock (bench/README.md, \"A class lump at "
-                                        "the element cap\")"));
+                                        " is below 2 x the coarsest, so it follows the element size (the "
+                                        "calibration's), not the rock"));
   }
   for (const auto& rpm : rpm_keys(circ)) {
     const json& c = circ.at(rpm);

@@ -251,9 +251,16 @@ TEST(Headline, ClosedCircuitNamesThePeightyTheElementsSet) {
   EXPECT_EQ(h.at("circuit_resolution").at("element_piece_mm"), json::parse("[2.31, 3.84]"));
   const auto rows = headline_rows(h);
   EXPECT_EQ(value_of(rows, "finest size the lumps resolve"),
-            "one element, 2.31-3.84 mm; the P80 at 2000 rpm is within 2 x of it, so it follows the "
-            "element size (the calibration's), not the rock (bench/README.md, \"A class lump at the "
-            "element cap\")");
+            "one element, 2.31-3.84 mm; the P80 at 2000 rpm is below 2 x the coarsest, so it follows "
+            "the element size (the calibration's), not the rock");
+  // Two speeds: "1500 and 2000 rpm".
+  std::ofstream(run / "breakage/circuit.json") << R"({"sieves_mm": [2, 4, 8],
+      "rotor_speeds": [{"rpm": 1500, "steady": true, "p50_mm": 5.1, "p80_mm": 4.8, "p80_set_by_elements": true},
+                       {"rpm": 2000, "steady": true, "p50_mm": 3.1, "p80_mm": 4.1, "p80_set_by_elements": true}],
+      "resolution": {"element_piece_mm": {"smallest": 2.31, "largest": 3.84}}})";
+  EXPECT_NE(value_of(headline_rows(mill::report::headline_json(run)), "finest size the lumps resolve")
+                .find("the P80 at 1500 and 2000 rpm is below"),
+            std::string::npos);
   // No speed bound by it: the span alone.
   std::ofstream(run / "breakage/circuit.json") << R"({"sieves_mm": [2, 4, 8],
       "rotor_speeds": [{"rpm": 1500, "steady": true, "p50_mm": 5.1, "p80_mm": 9.2, "p80_set_by_elements": false}],
