@@ -21,6 +21,11 @@ class Document;
 // A class with less than this share of the feed has no runs of its own
 // (a table's zeros; a Rosin-Rammler feed's far tails).
 inline constexpr double kFeedClassMinFraction = 1e-3;
+// A class lump of more than this many times lump.n_elements (a class of
+// about twice lump.diameter) names feed.class_element_cap in its plan line:
+// its runs cost that many times lump.diameter's.
+inline constexpr long kCostlyClassLumpFactor = 8;
+
 struct FeedClassRuns {
   std::size_t cls = 0;       // class index, coarsest first (post::SizeClassesFromSieves)
   std::string name;          // "16-22.4 mm"

@@ -147,7 +147,7 @@ namespace {
 
 // circuit.json's "resolution": the element pieces of every measured class's
 // lumps (the same lumps at every speed: the first speed's).
-nlohmann::json resolution_json(const MeasuringRuns& runs, double spread, double* largest_mm) {
+nlohmann::json resolution_json(const MeasuringRuns& runs, double spread) {
   nlohmann::json classes = nlohmann::json::array();
   double lo = INFINITY, hi = 0;
   if (!runs.empty())
@@ -163,7 +163,6 @@ nlohmann::json resolution_json(const MeasuringRuns& runs, double spread, double*
       lo = std::min(lo, e.smallest_mm);
       hi = std::max(hi, e.largest_mm);
     }
-  *largest_mm = hi;
   if (classes.empty()) return nullptr;
   return {{"element_piece_mm", {{"smallest", lo}, {"largest", hi}}},
           {"classes", classes},
@@ -252,9 +251,9 @@ void write_circuit(StageContext& ctx, const std::map<double, post::AssembledMatr
         s.mass_balance_residual));
   }
   // The finest size the lumps resolve, and which P80 it sets.
-  double largest_piece = 0;
-  const nlohmann::json resolution =
-      resolution_json(runs, ctx.cfg.doc.real("lump.radius_spread"), &largest_piece);
+  const nlohmann::json resolution = resolution_json(runs, ctx.cfg.doc.real("lump.radius_spread"));
+  const double largest_piece =
+      resolution.is_null() ? 0.0 : resolution.at("element_piece_mm").at("largest").get<double>();
   for (auto& e : speeds)
     if (largest_piece > 0 && e.contains("p80_mm") && e.at("p80_mm").is_number()) {
       e["p80_set_by_elements"] = e.at("p80_mm").get<double>() < kElementBoundP80Factor * largest_piece;

@@ -152,13 +152,13 @@ void plan_in_mill(const StageContext& ctx, double rpm, Plan& plan,
   }
   const std::string prefix = cls ? fmt::format("{}_c{}", rpm_label(rpm), cls->cls) : rpm_label(rpm);
   // A class lump off the calibration's element size (at feed.class_element_cap,
-  // or the packing's fewest) says so in its plan line.
-  // A large one says what it costs and what would cap it.
+  // or the packing's fewest) says so in its plan line; a costly one says what
+  // would cap it.
   std::string off_size;
   if (cls && std::abs(cls->element_size - 1) > 0.01)
     off_size = fmt::format(" (elements {:.2f} x the calibration's{})", cls->element_size,
                            cls->element_size > 1 ? ": feed.class_element_cap" : "");
-  else if (const long n_ref = d.integer("lump.n_elements"); cls && cls->n_elements > 8 * n_ref)
+  else if (const long n_ref = d.integer("lump.n_elements"); cls && cls->n_elements > config::kCostlyClassLumpFactor * n_ref)
     off_size = fmt::format(" ({:.0f} x lump.n_elements: feed.class_element_cap would cap it, with coarser elements)",
                            static_cast<double>(cls->n_elements) / static_cast<double>(n_ref));
   const std::string lumps = cls ? fmt::format(" feed {}, {:.4g} mm lump of {} elements{}:", cls->name,
