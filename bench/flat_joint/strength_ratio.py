@@ -2,6 +2,9 @@
 strength_ratio.sh: UCS = peak of the mean platen force over the cylinder's
 cross-section; T = 2 P / (pi D t) at the peak load P (ISRM Brazilian test);
 E = secant modulus at half the peak (gauge length from ucs_info.txt);
+nu = slope of the lateral strain against the axial strain between 20 and
+50 % of the peak on the loading branch (the calibrate stage's window,
+post::AnalyseUcs);
 K_IC of the semi-circular bend test when it ran (Kuruppu et al. 2014,
 eqs. 1-2, as post::ScbToughness)."""
 import math
@@ -26,7 +29,7 @@ def curve(path):
 def analyse(out, model):
     """UCS, T, E, peaked and K_IC; None for a test that did not run."""
     if not os.path.exists(f"{out}/{model}/ucs/ucs_info.txt"):
-        return None, None, None, None, toughness(out, model)
+        return None, None, None, None, None, toughness(out, model)
     ui = info(f"{out}/{model}/ucs/ucs_info.txt")
     uc = curve(f"{out}/{model}/ucs/ucs_curve.txt")
     d = float(ui["diameter"])
@@ -43,7 +46,24 @@ def analyse(out, model):
     load = max(0.5 * (r[3] + r[4]) for r in bc)
     tensile = 2 * load / (math.pi * float(bi["diameter"]) * float(bi["thickness"]))
     peaked = k + 1 < len(stress)
-    return ucs, tensile, young, peaked, toughness(out, model)
+    return ucs, tensile, young, poisson(stress, strain, [r[5] for r in uc], k), peaked, \
+        toughness(out, model)
+
+
+def poisson(stress, strain, lateral, k):
+    """Least-squares slope of lateral against axial strain over the loading
+    points between 20 and 50 % of the peak stress (post::AnalyseUcs)."""
+    lo, hi = 0.2 * stress[k], 0.5 * stress[k]
+    first = next(i for i in range(k + 1) if stress[i] >= lo)
+    idx = [i for i in range(first, k + 1) if stress[i] <= hi]
+    if len(idx) < 3:
+        return None
+    idx = list(range(idx[0], idx[-1] + 1))
+    mx = sum(strain[i] for i in idx) / len(idx)
+    my = sum(lateral[i] for i in idx) / len(idx)
+    sxx = sum((strain[i] - mx) ** 2 for i in idx)
+    sxy = sum((strain[i] - mx) * (lateral[i] - my) for i in idx)
+    return sxy / sxx if sxx > 0 else None
 
 
 def toughness(out, model):
@@ -64,16 +84,17 @@ def toughness(out, model):
 
 def main():
     out, models = sys.argv[1], sys.argv[2:]
-    print("| model | UCS [MPa] | tensile [MPa] | UCS/T | E (secant at UCS/2) [GPa] | UCS peaked "
-          "| K_IC [MPa m^0.5] |")
-    print("|---|---|---|---|---|---|---|")
+    print("| model | UCS [MPa] | tensile [MPa] | UCS/T | E (secant at UCS/2) [GPa] | nu "
+          "| UCS peaked | K_IC [MPa m^0.5] |")
+    print("|---|---|---|---|---|---|---|---|")
     for m in models:
-        ucs, t, e, peaked, k = analyse(out, m)
+        ucs, t, e, nu, peaked, k = analyse(out, m)
         kic = "-" if k is None else f"{k / 1e6:.3f}"
         if ucs is None:
-            print(f"| {m} | - | - | - | - | - | {kic} |")
+            print(f"| {m} | - | - | - | - | - | - | {kic} |")
             continue
-        print(f"| {m} | {ucs / 1e6:.1f} | {t / 1e6:.2f} | {ucs / t:.2f} | {e / 1e9:.1f} | "
+        nus = "-" if nu is None else f"{nu:.3f}"
+        print(f"| {m} | {ucs / 1e6:.1f} | {t / 1e6:.2f} | {ucs / t:.2f} | {e / 1e9:.1f} | {nus} | "
               f"{'yes' if peaked else 'no (cap reached)'} | {kic} |")
 
 

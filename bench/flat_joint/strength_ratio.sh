@@ -39,7 +39,7 @@ fj_extra="" bond_extra="" models="parallel flatjoint" tests="ucs brazilian"
 ucs_r=0.0131578 disc_r=0.0209757 scb_angle=0
 for kv in "$@"; do
   key=${kv%%=*}
-  case "$key" in *[!a-z_]* | "") echo "strength_ratio: '$kv' is not key=value" >&2; exit 2 ;; esac
+  case "$key" in *[!a-zA-Z_]* | "") echo "strength_ratio: '$kv' is not key=value" >&2; exit 2 ;; esac
   eval "$key=\${kv#*=}"
 done
 

@@ -557,6 +557,11 @@ void check_physics(const Document& d) {
           "elements always stay as frictional contacts); expected false or absent: remove it, or set "
           "lump.bond_model: parallel",
           d.where("lump.broken_contact")));
+  } else if (d.has("lump.joint_friction")) {
+    throw ConfigError(fmt::format(
+        "{}: the friction of a flat joint's broken elements, and lump.bond_model is parallel; expected it "
+        "absent: remove it, or set lump.bond_model: flat_joint",
+        d.where("lump.joint_friction")));
   }
   check_unique_items(d, "rotor.rpm", "rpm");
   check_unique_items(d, "breakage.velocities", "m/s");

@@ -333,7 +333,12 @@ std::vector<KeyDef> lump_keys() {
           range(key("lump.joint_sectors", T::Int, "", "3",
                     "Flat joint: sectors of elements per interface (at least 3: the intact interface then has the "
                     "disc's area and moments)"),
-                3, false, kMaxJointElements, false)};
+                3, false, kMaxJointElements, false),
+          opt(at_least(key("lump.joint_friction", T::Real, "", "",
+                           "Flat joint: friction coefficient of its broken elements (Potyondy 2012's mu; fix "
+                           "bond/flatjoint joint_friction); absent: tan of the bond friction angle. Part of the "
+                           "lump's scale a calibration holds for (bench/README.md, \"UCS/T of 10 at bond gap 1.4\")"),
+                       0))};
 }
 
 // The breakage stage: its sweep or transport conditions, and the in-mill runs.
@@ -635,6 +640,7 @@ Schema make_ore_schema() {
   s.keys.push_back(opt(key(ff + "bond_gap", T::Real, "", "", "lump.bond_gap of that fit")));
   s.keys.push_back(opt(key(ff + "bond_radius_multiplier", T::Real, "", "", "lump.bond_radius_multiplier of that fit")));
   s.keys.push_back(opt(key(ff + "broken_contact", T::Bool, "", "", "lump.broken_contact of that fit (parallel bond)")));
+  s.keys.push_back(opt(key(ff + "joint_friction", T::Real, "", "", "lump.joint_friction of that fit (flat joint; absent: not set)")));
   return s;
 }
 

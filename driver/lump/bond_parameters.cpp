@@ -174,8 +174,10 @@ std::vector<std::pair<std::string, std::string>> bond_deck_vars(const BondParams
     else if (uses(b, p))
       keys += fmt::format("{}{} {}", keys.empty() ? "" : " ", p.keyword, engine::num(b.*p.value));
   }
-  if (b.model == BondModel::flat_joint)
+  if (b.model == BondModel::flat_joint) {
     keys += fmt::format("{}elements {} {}", keys.empty() ? "" : " ", b.joint_rings, b.joint_sectors);
+    if (b.joint_friction >= 0) keys += fmt::format(" joint_friction {}", engine::num(b.joint_friction));
+  }
   v.emplace_back("bond_style", b.model == BondModel::flat_joint ? "flatjoint" : "breakable");
   v.emplace_back("bond_model_keys", keys);
   return v;

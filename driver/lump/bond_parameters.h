@@ -47,6 +47,9 @@ struct BondParams {
   BondModel model = BondModel::parallel;
   int joint_rings = 1;    // flat joint: rings of elements per interface
   int joint_sectors = 3;  // flat joint: sectors of elements per interface
+  // flat joint: friction coefficient of the broken elements (lump.joint_friction);
+  // negative: the style's default, tan of friction_angle_deg
+  double joint_friction = -1;
   std::string origin;     // where they come from, for reports
 };
 

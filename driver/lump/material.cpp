@@ -33,6 +33,10 @@ nlohmann::json lump_scale(const config::CaseConfig& cfg) {
                       {"bond_radius_multiplier", d.real("lump.bond_radius_multiplier")}};
   if (bond_model_from(d.str("lump.bond_model")) == BondModel::parallel)
     s["broken_contact"] = d.boolean("lump.broken_contact");
+  // Absent, the broken elements' friction follows the fitted friction angle:
+  // no entry, so the calibrations made before the key still hold.
+  else if (d.has("lump.joint_friction"))
+    s["joint_friction"] = d.real("lump.joint_friction");
   return s;
 }
 
@@ -68,6 +72,7 @@ BondParams estimate_bond_params(const config::Document& ore, const config::Docum
   }
   b.joint_rings = static_cast<int>(doc.integer("lump.joint_rings"));
   b.joint_sectors = static_cast<int>(doc.integer("lump.joint_sectors"));
+  if (doc.has("lump.joint_friction")) b.joint_friction = doc.real("lump.joint_friction");
   b.origin = "closed-form estimate (not calibrated: run --stage calibrate)";
   return b;
 }
@@ -119,12 +124,18 @@ std::string mismatch(const YAML::Node& c, const config::CaseConfig& cfg) {
                                            1e-6 * std::abs(v.get<double>());
     if (!same) diffs.push_back(fmt::format("{} {} (this case: {})", k, theirs, mine));
   }
+  // The broken elements' friction is recorded only when set: absent on one
+  // side is "not set" (the style's tan(phi_b)), not an older format.
+  const char* jf = "joint_friction";
+  if (f[jf].IsDefined() != scale.contains(jf))
+    diffs.push_back(f[jf] ? fmt::format("{} {} (this case: not set)", jf, f[jf].as<std::string>())
+                          : fmt::format("{} not set (this case: {:.6g})", jf, scale[jf].get<double>()));
   if (diffs.empty()) return "fitted to other card properties (its input_hash is another)";
   std::string out = "fitted for another lump scale: ";
   for (size_t i = 0; i < diffs.size(); ++i) out += (i ? ", " : "") + diffs[i];
   return out +
          "; the scale follows lump.n_elements, lump.diameter, lump.radius_spread, "
-         "lump.bond_gap, lump.bond_radius_multiplier and lump.broken_contact";
+         "lump.bond_gap, lump.bond_radius_multiplier, lump.broken_contact and lump.joint_friction";
 }
 
 // Why `file` gives no calibration for the case; empty when it does.

@@ -102,6 +102,8 @@ TEST(BondParameters, DeckVariablesOfEachModel) {
   b.joint_sectors = 5;
   EXPECT_EQ(value(b, "bond_style"), "flatjoint");
   EXPECT_EQ(value(b, "bond_model_keys"), "elements 1 5");
+  b.joint_friction = 0.75;  // lump.joint_friction: the broken elements' mu
+  EXPECT_EQ(value(b, "bond_model_keys"), "elements 1 5 joint_friction 0.75");
 }
 
 // calibrated.yaml's map: today's lines, byte for byte and in this order, then

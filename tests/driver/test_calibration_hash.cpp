@@ -125,3 +125,43 @@ TEST(CalibrationHash, CardFittedAtAnotherElementSizeIsNotUsedAndSaysWhy) {
   EXPECT_EQ(why.find("bond_gap 1"), std::string::npos) << why;  // the same range: no difference
   EXPECT_NE(why.find("calibrated.yaml"), std::string::npos) << why;  // the run's file looked at
 }
+
+// The flat joint's broken-element friction (lump.joint_friction) moves the
+// strength ratio (bench/README.md, "UCS/T of 10 at bond gap 1.4"): set, it is
+// part of the scale; absent, the hash is the one of the calibrations made
+// before the key; a section fitted without it is not taken with it, and says
+// so both ways.
+TEST(CalibrationHash, JointFrictionIsPartOfTheFlatJointsScale) {
+  const mill::test::TempDir dir("mill_cal_jf_" + std::to_string(getpid()));
+  const std::string fj = "{bond_model: flat_joint, bond_gap: 1.4, max_bonds: 48, n_elements: 2000";
+  const auto none = with_card(dir / "none", 0.73e6, fj + "}"),
+             one = with_card(dir / "one", 0.73e6, fj + ", joint_friction: 1.0}"),
+             other = with_card(dir / "other", 0.73e6, fj + ", joint_friction: 0.8}");
+  EXPECT_FALSE(mill::lump_scale(none).contains("joint_friction"));
+  EXPECT_DOUBLE_EQ(mill::lump_scale(one)["joint_friction"].get<double>(), 1.0);
+  EXPECT_NE(mill::calibration_hash(none), mill::calibration_hash(one));
+  EXPECT_NE(mill::calibration_hash(one), mill::calibration_hash(other));
+  EXPECT_DOUBLE_EQ(mill::estimate_bond_params(one.ore, one.doc).joint_friction, 1.0);
+  EXPECT_LT(mill::estimate_bond_params(none.ore, none.doc).joint_friction, 0);
+
+  // A run folder whose calibrated.yaml was fitted without the key.
+  const auto section = [&](const mill::config::CaseConfig& c) {
+    YAML::Emitter y;
+    y << YAML::BeginMap;
+    mill::emit_calibrated(y, mill::estimate_bond_params(c.ore, c.doc), mill::calibration_hash(c),
+                          mill::lump_scale(c));
+    y << YAML::EndMap;
+    return std::string(y.c_str()) + "\n";
+  };
+  const fs::path run = dir / "run";
+  fs::create_directories(run / "calibrate");
+  std::ofstream(run / "calibrate" / "calibrated.yaml") << section(none);
+  EXPECT_EQ(mill::uncalibrated_reason(none, run), "");
+  const std::string why = mill::uncalibrated_reason(one, run);
+  EXPECT_NE(why.find("joint_friction not set (this case: 1)"), std::string::npos) << why;
+  std::ofstream(run / "calibrate" / "calibrated.yaml") << section(one);
+  const std::string back = mill::uncalibrated_reason(none, run);
+  EXPECT_NE(back.find("joint_friction 1 (this case: not set)"), std::string::npos) << back;
+  EXPECT_NE(mill::uncalibrated_reason(other, run).find("joint_friction 1 (this case: 0.8)"),
+            std::string::npos);
+}
