@@ -88,7 +88,7 @@ FixBondBreakable::FixBondBreakable(LAMMPS *lmp, int narg, char **arg) : Fix(lmp,
   restart_global = 1;
   restart_peratom = 1;
   vector_flag = 1;
-  size_vector = 7;
+  size_vector = 8;
   global_freq = 1;
   extvector = 0;
   peratom_flag = 1;
@@ -1334,19 +1334,26 @@ void FixBondBreakable::write_bond_dump() {
 double FixBondBreakable::critical_step() {
   double *radius = atom->radius, *rmass = atom->rmass;
   const mill::step_limit::BondSprings springs{modulus_, stiffness_ratio_, radius_multiplier_};
-  double local = 0.0;  // largest per-atom sum of the bonds' omega^2
+  // [0]: the largest per-atom sum of the bonds' omega^2; [1]: minus the
+  // smallest per-atom step with the dashpots (one MAX reduction for both).
+  double local[2] = {0.0, -HUGE_VAL};
   for (int i = 0; i < atom->nlocal; ++i) {
-    double sum = 0.0;
+    double sum2 = 0.0, sum1 = 0.0;
     for (int k = 0; k < nbond_[i]; ++k) {
       const int j = partner_index(i, static_cast<int>(bonds_[i][k * ncol_ + PARTNER]));
-      sum += mill::step_limit::bond_omega2(
+      const double w2 = mill::step_limit::bond_omega2(
           springs, {radius[i], radius[j], rmass[i], rmass[j], bonds_[i][k * ncol_ + L0]});
+      sum2 += w2;
+      sum1 += std::sqrt(w2);
     }
-    local = std::max(local, sum);
+    local[0] = std::max(local[0], sum2);
+    if (sum2 > 0.0)
+      local[1] = std::max(local[1], -mill::step_limit::damped_critical_step(sum2, sum1, damping_));
   }
-  double global = 0.0;
-  MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_MAX, world);
-  dt_crit_ = mill::step_limit::critical_step(global);
+  double global[2] = {0.0, 0.0};
+  MPI_Allreduce(local, global, 2, MPI_DOUBLE, MPI_MAX, world);
+  dt_crit_ = mill::step_limit::critical_step(global[0]);
+  dt_crit_damped_ = global[0] > 0.0 ? -global[1] : 0.0;
   return dt_crit_;
 }
 
@@ -1355,14 +1362,19 @@ double FixBondBreakable::critical_step() {
 void FixBondBreakable::estimate_time_step() {
   if (critical_step() <= 0.0) return;
   char line[256];
-  snprintf(line, sizeof(line),
-           "%scritical time step of bond springs %.4g s; time step %.4g s",
-           label().c_str(), dt_crit_, update->dt);
+  if (damping_ > 0.0)
+    snprintf(line, sizeof(line),
+             "%scritical time step of bond springs %.4g s, %.4g s with their dashpots; time step "
+             "%.4g s",
+             label().c_str(), dt_crit_, dt_crit_damped_, update->dt);
+  else
+    snprintf(line, sizeof(line), "%scritical time step of bond springs %.4g s; time step %.4g s",
+             label().c_str(), dt_crit_, update->dt);
   message(line);
-  if (update->dt > dt_crit_ && comm->me == 0) {
+  if (update->dt > dt_crit_damped_ && comm->me == 0) {
     snprintf(line, sizeof(line),
              "%stime step %g s exceeds the bond critical time step %g s",
-             label().c_str(), update->dt, dt_crit_);
+             label().c_str(), update->dt, dt_crit_damped_);
     error->warning(FLERR, line);
   }
 }
@@ -1391,6 +1403,8 @@ double FixBondBreakable::compute_vector(int n) {
       MPI_Allreduce(local, global, 2, MPI_DOUBLE, MPI_SUM, world);
       return global[0] + global[1] > 0.0 ? global[0] / (global[0] + global[1]) : 0.0;
     }
+    case 7:
+      return dt_crit_damped_;
     default:
       return 0.0;
   }

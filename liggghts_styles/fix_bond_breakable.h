@@ -89,7 +89,8 @@ class FixBondBreakable : public Fix {
   // This step's bond forces and torques on the owned atoms (6 per atom).
   const std::vector<double> &ledger_forces() const { return fbond_; }
   // The bond springs' critical time step over the bonds left now [s], 0
-  // when none is left (step_limit.h); also what f_ID[6] reads from then on.
+  // when none is left (step_limit.h); also what f_ID[6] reads from then on,
+  // and f_ID[8] the same with the dashpots (damped_critical_step).
   // Collective: every rank calls it at the same step.
   double critical_step();
 
@@ -138,6 +139,7 @@ class FixBondBreakable : public Fix {
   double intact_ = 0.0;
   double energy_ = 0.0;
   double dt_crit_ = 0.0;
+  double dt_crit_damped_ = 0.0;  // with the dashpots (f_ID[8]); dt_crit_ when damping is 0
 
   // Per-atom storage.
   int nmax_ = 0;

@@ -66,6 +66,30 @@ inline double critical_step(double max_omega2_sum) {
   return max_omega2_sum > 0.0 ? 2.0 / std::sqrt(max_omega2_sum) : 0.0;
 }
 
+// The critical step of one atom's springs with their dashpots [s]. The
+// bonds' dashpots damp each pair's mode at the fraction `damping` of
+// critical (fix bond/breakable, `damping`); an atom's top mode, whose
+// squared frequency is the sum omega2_sum of its bonds' omega_b^2, is then
+// damped at
+//   zeta = damping x (sum of omega_b) / sqrt(sum of omega_b^2)
+// (the dashpots add as damping x 2 / omega_b times each bond's stiffness;
+// zeta = damping for one bond, up to damping x sqrt(n) for n equal ones),
+// and velocity Verlet, whose dashpot force takes the half-step velocity,
+// is stable for
+//   omega dt < 2 (sqrt(1 + zeta^2) - zeta)
+// (its recurrence x_{k+2} - 2 x_{k+1} + x_k = -h^2 x_{k+1} - 2 zeta h
+// (x_{k+1} - x_k), h = omega dt, by the Jury conditions; the central
+// difference method's bound in Belytschko, Liu & Moran 2000, Nonlinear
+// Finite Elements for Continua and Structures, eq. 6.2.12). With no
+// dashpots (damping 0) it is critical_step(omega2_sum). 0 when the atom has
+// no bond.
+inline double damped_critical_step(double omega2_sum, double omega_sum, double damping) {
+  if (!(omega2_sum > 0.0)) return 0.0;
+  const double omega = std::sqrt(omega2_sum);
+  const double zeta = damping * omega_sum / omega;
+  return 2.0 / omega * (std::sqrt(1.0 + zeta * zeta) - zeta);
+}
+
 // The step rule of fix step/adaptive (docs/styles/fix_step_adaptive.md).
 struct StepRule {
   double safety = 0.5;  // the step is at most this share of the bonds' critical step [-]

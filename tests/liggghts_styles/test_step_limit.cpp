@@ -268,3 +268,60 @@ TEST(StepLimit, GrowthLimitedAndShrinksAtOnce) {
   EXPECT_DOUBLE_EQ(mill::step_limit::critical_step(0.0), 0.0);            // no bond: no bound
   EXPECT_DOUBLE_EQ(mill::step_limit::critical_step(4.0), 1.0);            // omega dt = 2
 }
+
+namespace {
+// Largest |x| over the last half of `steps` steps of one damped oscillator
+// (omega 1, damping ratio zeta, x0 = 1) integrated as LIGGGHTS does: velocity
+// Verlet whose dashpot force takes the half-step velocity, the one the atoms
+// hold when the fixes compute their forces.
+double damped_run_amplitude(double zeta, double dt, int steps) {
+  double x = 1.0, v = 0.0, a = -x, late = 0.0;
+  for (int k = 0; k < steps; ++k) {
+    const double v_half = v + 0.5 * dt * a;
+    x += dt * v_half;
+    a = -x - 2.0 * zeta * v_half;
+    v = v_half + 0.5 * dt * a;
+    if (k >= steps / 2) late = std::max(late, std::abs(x));
+    if (!(std::abs(x) < 1e12)) return HUGE_VAL;
+  }
+  return late;
+}
+}  // namespace
+
+// The damped critical step is the integrator's limit: for each damping ratio
+// the closed form 2 (sqrt(1 + zeta^2) - zeta) / omega; at 0.98 x it the
+// oscillator decays (or, undamped, keeps its amplitude), at 1.02 x it blows
+// up. zeta 0.85 is the lab decks' 0.2 per bond on an atom of 18 bonds.
+TEST(StepLimit, DampedCriticalStepIsTheIntegratorsLimit) {
+  for (const double zeta : {0.0, 0.2, 0.5, 0.85, 2.0}) {
+    const double dt = mill::step_limit::damped_critical_step(1.0, 1.0, zeta);
+    EXPECT_NEAR(dt, 2.0 * (std::sqrt(1.0 + zeta * zeta) - zeta), 1e-15) << "zeta " << zeta;
+    const double below = damped_run_amplitude(zeta, 0.98 * dt, 20000);
+    const double above = damped_run_amplitude(zeta, 1.02 * dt, 20000);
+    EXPECT_LE(below, 1.0 + 1e-9) << "zeta " << zeta << ": 0.98 x the step grows";
+    EXPECT_GT(above, 1e3) << "zeta " << zeta << ": 1.02 x the step stays bounded";
+  }
+  // Without dashpots it is the undamped step of the same sum.
+  EXPECT_DOUBLE_EQ(mill::step_limit::damped_critical_step(4.0, 3.0, 0.0),
+                   mill::step_limit::critical_step(4.0));
+  EXPECT_DOUBLE_EQ(mill::step_limit::damped_critical_step(0.0, 0.0, 0.2), 0.0);  // no bond
+}
+
+// An atom of n equal bonds (each omega_b, damping d) is damped at d sqrt(n):
+// its step is 2 / (sqrt(n) omega_b) (sqrt(1 + n d^2) - d sqrt(n)); the
+// undamped per-atom sum's step is the first factor alone.
+TEST(StepLimit, DampedCriticalStepOfEqualBondsGrowsTheDampingWithTheirNumber) {
+  const double w = 3.0e7, d = 0.2;
+  for (const int n : {1, 6, 13, 18}) {
+    const double zeta = d * std::sqrt(static_cast<double>(n));
+    const double want = 2.0 / (std::sqrt(n) * w) * (std::sqrt(1.0 + zeta * zeta) - zeta);
+    EXPECT_NEAR(mill::step_limit::damped_critical_step(n * w * w, n * w, d) / want, 1.0, 1e-12)
+        << n << " bonds";
+  }
+  // At 18 bonds the damped step is below half the undamped one (0.46 x):
+  // the decks' 0.5 x the undamped step is then past the limit.
+  EXPECT_LT(mill::step_limit::damped_critical_step(18 * w * w, 18 * w, d),
+            0.5 * mill::step_limit::critical_step(18 * w * w));
+  EXPECT_GT(mill::step_limit::damped_critical_step(6 * w * w, 6 * w, d),
+            0.5 * mill::step_limit::critical_step(6 * w * w));
+}
