@@ -524,6 +524,12 @@ std::vector<KeyDef> calibrate_keys() {
             1, false, 12, false),
       key("calibrate.rate_check", T::Bool, "", "true",
           "After the fit, repeat the UCS test at half the strain rate (quasi-static check)"),
+      range(key("calibrate.packing_check", T::Int, "", "2",
+                "After the fit, repeat the result's UCS and Brazilian tests on this many further specimen "
+                "packings (the seed streams after calibrate.seed's) and report how far E, nu, UCS and the tensile "
+                "strength spread between the packings; beyond the fit's tolerance it warns that the "
+                "specimens are too small (docs/calibration.md, \"Packing check\"). 0: no check"),
+            0, false, 8, false),
       key("calibrate.sensitivity", T::Bool, "", "true",
           "After the fit, step each fitted bond parameter alone from the result (x1.2; friction angle +5 deg; "
           "moment factor -0.25) in one UCS + Brazilian pair each and report each lever's sensitivity (the "

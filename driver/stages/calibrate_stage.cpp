@@ -161,10 +161,12 @@ void Calibration::run() {
               : 0.0;
   const bool sensitivity = primary && d_.boolean("calibrate.sensitivity");
   const bool rate_check = primary && d_.boolean("calibrate.rate_check");
+  const int n_packings = primary ? static_cast<int>(d_.integer("calibrate.packing_check")) : 0;
   const double n_sensitivity =
       sensitivity ? 2.0 * static_cast<double>(sensitivity_levers(p).size()) : 0.0;
   const double per_it = fit_.fits_toughness() ? 3.0 : 2.0;
-  const double steps_total = per_it * max_it_ + (rate_check ? 2.0 : 0.0) + n_sensitivity + n_checks;
+  const double steps_total =
+      per_it * max_it_ + (rate_check ? 2.0 : 0.0) + 2.0 * n_packings + n_sensitivity + n_checks;
   for (int k = 1; k <= max_it_; ++k) {
     Iteration it;
     it.p = p;
@@ -217,10 +219,52 @@ void Calibration::run() {
     o.half = lab.ucs(hist[o.best].p, 0.5 * rate_,
                      {"rate_check_ucs", "rate check: UCS at half the strain rate",
                       per_it * max_it_ / steps_total});
+  // Packing check: the best parameters on further packings, each its own ball.
+  const double after_rate = per_it * max_it_ + (rate_check ? 2.0 : 0.0);
+  for (int k = 1; k <= n_packings; ++k) {
+    PackingRun r;
+    const Specimen spk = pack_specimen(ctx_, job_.label, dir_, n_, k);
+    r.seed = spk.seed;
+    LabBench other(ctx_, job_.label, dir_, spk, t);
+    other.set_lanes(lab.lanes());
+    const BondParams& best = hist[o.best].p;
+    const double at = after_rate + 2.0 * (k - 1);
+    run_concurrently(
+        {[&] {
+           r.ucs = other.ucs(best, rate_,
+                             {fmt::format("packing{}_ucs", k),
+                              fmt::format("packing check {}/{}: UCS (seed {})", k, n_packings, r.seed),
+                              at / steps_total});
+         },
+         [&] {
+           r.br = other.brazilian(
+               best, rate_,
+               {fmt::format("packing{}_brazilian", k),
+                fmt::format("packing check {}/{}: Brazilian (seed {})", k, n_packings, r.seed),
+                (at + 1.0) / steps_total});
+         }},
+        other.lanes());
+    o.packings.push_back(std::move(r));
+  }
+  if (!o.packings.empty()) {
+    o.packing =
+        packing_spread(hist[o.best], o.specimen.seed, o.packings, fit_.tolerance(), kNuTolerance);
+    ctx_.progress.info(fmt::format(
+        "[calibrate] packing check over {} packings: spread E {:.1f}%, nu {:.3f}, UCS {:.1f}%, "
+        "tensile {:.1f}%",
+        o.packing->seeds.size(), 100 * o.packing->E.spread, o.packing->nu.spread,
+        100 * o.packing->ucs.spread, 100 * o.packing->tensile.spread));
+    const std::string w = packing_warning(*o.packing, n_);
+    if (!w.empty()) {
+      ctx_.progress.warn(w);
+      notes.push_back(w.substr(w.find(']') + 2));
+    }
+  }
   // Sensitivities: each lever stepped alone from the best parameters.
   if (sensitivity) {
     o.sensitivity = run_sensitivity(lab, hist[o.best].p, rate_,
-                                    (per_it * max_it_ + 2.0) / steps_total, 1.0 / steps_total);
+                                    (after_rate + 2.0 * n_packings) / steps_total,
+                                    1.0 / steps_total);
     const Noise noise = sensitivity_noise(hist[o.best].ucs, o.half ? &*o.half : nullptr);
     for (const LeverRun& run : o.sensitivity) {
       const LeverSensitivity s = lever_sensitivity(hist[o.best], run);
@@ -235,7 +279,8 @@ void Calibration::run() {
   if (primary)
     o.checks = run_checks(lab, hist[o.best].p, hist[o.best].ucs, rate_,
                           confining_pressures(d_, hist[o.best].ucs.r.ucs), check_for,
-                          (per_it * max_it_ + 2.0 + n_sensitivity) / steps_total, 1.0 / steps_total,
+                          (after_rate + 2.0 * n_packings + n_sensitivity) / steps_total,
+                          1.0 / steps_total,
                           scb_orientations_, hist[o.best].scb ? &*hist[o.best].scb : nullptr);
   o.checks.toughness_fitted = fit_.fits_toughness();
   o.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

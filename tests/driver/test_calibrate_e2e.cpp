@@ -97,6 +97,8 @@ TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
       {"it1_ucs", r["iterations"][0]["energy"]["ucs"]},
       {"it1_brazilian", r["iterations"][0]["energy"]["brazilian"]},
       {"rate_check_ucs", r["rate_check"]["energy"]},
+      {"packing1_ucs", r["packing_check"]["runs"][0]["energy"]["ucs"]},
+      {"packing2_brazilian", r["packing_check"]["runs"][1]["energy"]["brazilian"]},
       {"sens_bond_modulus_ucs", r["sensitivity"]["levers"]["bond_modulus"]["energy"]["ucs"]},
       {"sens_bond_moment_factor_brazilian",
        r["sensitivity"]["levers"]["bond_moment_factor"]["energy"]["brazilian"]},
@@ -114,9 +116,32 @@ TEST_F(TinyCalibration, BothTestsGiveFinitePositivePropertiesAndEveryOutput) {
     EXPECT_GE(e["bond_released_J"].get<double>(), 0.0) << run << ": " << e.dump();
   }
   const auto& worst = r["energy"];
-  // 2 (iteration) + 1 (rate check) + 12 (6 levers) + 2 (triaxial checks)
-  // + 6 (the bend test's half discs, calibrate.scb_orientations).
-  EXPECT_EQ(worst["lab_runs"].get<int>(), 23) << worst.dump();
+  // 2 (iteration) + 1 (rate check) + 4 (2 further packings: a UCS and a
+  // Brazilian each) + 12 (6 levers) + 2 (triaxial checks) + 6 (the bend
+  // test's half discs, calibrate.scb_orientations).
+  EXPECT_EQ(worst["lab_runs"].get<int>(), 27) << worst.dump();
+  // The packing check: the fit's seed and two more, each property's spread.
+  const auto& pc = r["packing_check"];
+  ASSERT_TRUE(pc.is_object()) << r.dump(2);
+  // Three distinct packings (neighbouring calibrate.seed values can share a
+  // prime: the check takes the next streams whose first seed is new).
+  ASSERT_EQ(pc["seeds"].size(), 3u);
+  EXPECT_NE(pc["seeds"][0], pc["seeds"][1]);
+  EXPECT_NE(pc["seeds"][1], pc["seeds"][2]);
+  EXPECT_NE(pc["seeds"][0], pc["seeds"][2]);
+  const auto& tv = pc["tensile_strength"]["values"];
+  EXPECT_NE(tv[1].get<double>(), tv[2].get<double>()) << pc.dump();  // not one packing twice
+  for (const char* k : {"youngs_modulus", "poisson_ratio", "ucs", "tensile_strength"}) {
+    ASSERT_EQ(pc[k]["values"].size(), 3u) << k;
+    EXPECT_GE(pc[k]["spread"].get<double>(), 0.0) << k;
+    EXPECT_EQ(pc[k]["within"].get<bool>(),
+              pc[k]["spread"].get<double>() <= pc[k]["limit"].get<double>())
+        << k;
+  }
+  EXPECT_TRUE(fs::exists(*dir_ / "calibrate" / "jobs" / "calibration" /
+                         ("specimen_seed" + std::to_string(pc["seeds"][2].get<long>())) /
+                         "ball.data"));
+  EXPECT_NE(slurp(*dir_ / "calibrate" / "report.md").find("## Packing check"), std::string::npos);
   EXPECT_LT(worst["worst_residual_fraction_max"].get<double>(), 0.01) << worst.dump();
   const std::string worst_run = worst["worst_run"].get<std::string>();
   EXPECT_TRUE(std::any_of(runs.begin(), runs.end(), [&](const auto& run) {

@@ -35,8 +35,8 @@ nlohmann::json lab_energy_json(const post::LedgerSummary& e) {
           {"end_time_s", e.end_time_s}};
 }
 
-// Iterations in order, each UCS then Brazilian, the rate check, the levers'
-// sensitivity pairs, then the checks.
+// Iterations in order, each UCS then Brazilian, the rate check, the packing
+// check's pairs, the levers' sensitivity pairs, then the checks.
 std::vector<const LabRun*> lab_runs(const Outcome& o) {
   std::vector<const LabRun*> runs;
   for (const Iteration& it : o.hist) {
@@ -46,6 +46,10 @@ std::vector<const LabRun*> lab_runs(const Outcome& o) {
       for (const ScbDisc& d : it.scb->discs) runs.push_back(&d);
   }
   if (o.half) runs.push_back(&*o.half);
+  for (const PackingRun& p : o.packings) {
+    runs.push_back(&p.ucs);
+    runs.push_back(&p.br);
+  }
   for (const LeverRun& l : o.sensitivity) {
     runs.push_back(&l.ucs);
     runs.push_back(&l.br);
@@ -70,7 +74,7 @@ nlohmann::json energy_summary_json(const Outcome& o) {
        {{"ledgers",
          "jobs/calibration/runs/<run>/ledger.csv (fix energy/ledger, "
          "docs/styles/fix_energy_ledger.md); each run's figures are in its `energy` object "
-         "(iterations[].energy.ucs, .brazilian, rate_check.energy, "
+         "(iterations[].energy.ucs, .brazilian, rate_check.energy, packing_check.runs[].energy, "
          "sensitivity.levers.<lever>.energy, checks.triaxial[].energy, checks.scb.discs[].energy)"},
         {"work_other_J",
          "the platens' drive: work done on the specimen by the moving platens (triaxial: and by "

@@ -85,6 +85,22 @@ class Report {
 
  private:
   std::vector<std::string> explain_missed() const;
+  // report.json's packing_check: the spread and each further packing's runs
+  // (null without the check).
+  nlohmann::json packing_check_json() const {
+    if (!o_.packing) return nullptr;
+    nlohmann::json j = packing_json(*o_.packing, o_.packings);
+    nlohmann::json runs = nlohmann::json::array();
+    for (const PackingRun& r : o_.packings)
+      runs.push_back({{"seed", r.seed},
+                      {"ucs_run", r.ucs.tag},
+                      {"brazilian_run", r.br.tag},
+                      {"energy",
+                       {{"ucs", lab_energy_json(r.ucs.energy)},
+                        {"brazilian", lab_energy_json(r.br.energy)}}}});
+    j["runs"] = runs;
+    return j;
+  }
 
   const config::Document& d_;
   const config::Document& ore_;
@@ -285,6 +301,7 @@ nlohmann::json Report::json() const {
                                             {"energy", lab_energy_json(half_->energy)},
                                             {"wall_seconds", half_->seconds}}
                            : nlohmann::json(nullptr)},
+      {"packing_check", packing_check_json()},
       {"sensitivity", o_.sensitivity.empty() ? nlohmann::json(nullptr)
                                              : sensitivity_json(b_, o_.sensitivity, tol_, noise_)},
       {"checks", checks_json(o_.checks, b_.ucs.r.ucs)},
@@ -398,6 +415,8 @@ std::string Report::markdown() const {
         rate_ok_ ? "below 5%: quasi-static" : "5% or more: lower calibrate.strain_rate");
   else
     md << "\n## Loading rate\n\nNot checked (calibrate.rate_check: false).\n";
+  md << (o_.packing ? packing_markdown(*o_.packing)
+                    : std::string("\n## Packing check\n\nNot run (calibrate.packing_check: 0).\n"));
   if (!o_.sensitivity.empty())
     md << sensitivity_markdown(b_, o_.sensitivity, tol_, noise_);
   else

@@ -12,6 +12,7 @@
 #include "stages/calibrate/checks.h"
 #include "stages/calibrate/fitting.h"
 #include "stages/calibrate/lab_runs.h"
+#include "stages/calibrate/packing_check.h"
 #include "stages/calibrate/sensitivity.h"
 #include "stages/calibrate/specimen.h"
 #include "stages/stage.h"
@@ -25,6 +26,8 @@ struct Outcome {
   size_t best = 0;              // index in hist of the result
   std::optional<UcsRun> half;   // rate check: the result's UCS test at half the strain rate
   std::vector<LeverRun> sensitivity;  // one perturbed UCS + Brazilian pair per lever (or none)
+  std::vector<PackingRun> packings;   // packing check: the result on further packings (or none)
+  std::optional<PackingSpread> packing;  // their spread, with the fit's own packing
   Checks checks;                // triaxial envelope and toughness with the result's parameters
   std::vector<std::string> notes;
   double wall = 0;  // s, the whole job

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -99,7 +100,19 @@ namespace {
 // The ball the specimens are carved from: kBallFactor x n elements of the
 // lump's size (same radius classes, spread and mean radius as the lump),
 // seed stream prime_stream(calibrate.seed) (packing_seeds).
-BallPacking specimen_ball(const config::CaseConfig& cfg, long n) {
+// The seed stream of packing k: k = 0 calibrate.seed's (prime_stream), k > 0
+// the k-th later stream whose first seed is new.
+long specimen_stream(long seed, int packing) {
+  long stream = prime_stream(seed);
+  std::set<long> used{packing_seeds(stream).dist};
+  for (int k = 0; k < packing; ++k) {
+    while (used.count(packing_seeds(stream).dist)) ++stream;
+    used.insert(packing_seeds(stream).dist);
+  }
+  return stream;
+}
+
+BallPacking specimen_ball(const config::CaseConfig& cfg, long n, int packing) {
   const config::Document& d = cfg.doc;
   BallPacking b;
   b.spread = d.real("lump.radius_spread");
@@ -110,7 +123,7 @@ BallPacking specimen_ball(const config::CaseConfig& cfg, long n) {
   b.nu = cfg.ore.real("poisson_ratio");
   b.bond_gap = d.real("lump.bond_gap");
   b.max_bonds = d.integer("lump.max_bonds");
-  b.seed_stream = prime_stream(d.integer("calibrate.seed"));
+  b.seed_stream = specimen_stream(d.integer("calibrate.seed"), packing);
   return b;
 }
 
@@ -119,18 +132,21 @@ BallPacking specimen_ball(const config::CaseConfig& cfg, long n) {
 // Pack a ball of polydisperse elements with the lump's packing (pack_ball)
 // and carve the n-element specimens from it.
 Specimen pack_specimen(StageContext& ctx, const std::string& job_label, const fs::path& dir,
-                       long n) {
+                       long n, int packing) {
   Specimen s;
-  const BallPacking ball = specimen_ball(ctx.cfg, n);
+  const BallPacking ball = specimen_ball(ctx.cfg, n, packing);
   const long nb = ball.n_elements;
-  const fs::path work = dir / "specimen";
+  s.seed = packing_seeds(ball.seed_stream).dist;
+  const std::string sub =
+      packing == 0 ? std::string("specimen") : fmt::format("specimen_seed{}", s.seed);
+  const fs::path work = dir / sub;
   ctx.progress.job_step(job_label, fmt::format("packing a ball of {} elements", nb), 0.0);
   ctx.progress.info(fmt::format(
       "[calibrate] packing a ball of {} elements (mean radius {:.3f} mm, as the lump) to carve "
       "the specimens from",
       nb, ball.mean_radius * 1e3));
   const LumpInfo li = pack_ball({ctx.runner, ctx.progress, ctx.cfg.project_dir}, ball, work, "ball",
-                                "calibrate/" + job_label + "/specimen", job_label);
+                                "calibrate/" + job_label + "/" + sub, job_label);
   s.ball = work / "ball.data";
   s.ball_elements = li.elements;
   s.ball_outer_radius = li.outer_radius;

@@ -1,0 +1,131 @@
+// The packing check: the result's spread over further specimen packings.
+#include "stages/calibrate/packing_check.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace mill::calibrate {
+
+namespace {
+
+// Mean and spread of `v` (relative to the mean, or absolute).
+PackingProperty property(std::vector<double> v, double limit, bool absolute) {
+  PackingProperty p;
+  p.values = std::move(v);
+  p.limit = limit;
+  double sum = 0;
+  for (double x : p.values) sum += x;
+  p.mean = sum / static_cast<double>(p.values.size());
+  const auto [lo, hi] = std::minmax_element(p.values.begin(), p.values.end());
+  const double range = *hi - *lo;
+  p.spread = absolute ? range : (p.mean != 0 ? range / std::abs(p.mean) : 0.0);
+  return p;
+}
+
+// The rows of the table and of the warning: name, unit scale, unit, property.
+struct Row {
+  const char* name;
+  const char* json;  // its key in report.json
+  double scale;
+  const char* unit;
+  const PackingProperty* p;
+  bool absolute;
+};
+
+std::vector<Row> rows(const PackingSpread& s) {
+  return {{"E", "youngs_modulus", 1e-9, "GPa", &s.E, false},
+          {"nu", "poisson_ratio", 1.0, "", &s.nu, true},
+          {"UCS", "ucs", 1e-6, "MPa", &s.ucs, false},
+          {"tensile", "tensile_strength", 1e-6, "MPa", &s.tensile, false}};
+}
+
+std::string spread_text(const Row& r) {
+  return r.absolute ? fmt::format("{:.3f}", r.p->spread) : fmt::format("{:.1f}%", 100 * r.p->spread);
+}
+std::string limit_text(const Row& r) {
+  return r.absolute ? fmt::format("{:.2f}", r.p->limit) : fmt::format("{:.0f}%", 100 * r.p->limit);
+}
+
+}  // namespace
+
+PackingSpread packing_spread(const Iteration& best, long seed, const std::vector<PackingRun>& runs,
+                             double tol, double nu_tol) {
+  if (runs.empty()) throw std::invalid_argument("packing check: no further packing ran");
+  PackingSpread s;
+  s.seeds.push_back(seed);
+  std::vector<double> e{best.ucs.r.youngs_modulus}, nu{best.ucs.r.poisson_ratio},
+      ucs{best.ucs.r.ucs}, t{best.br.r.tensile_strength};
+  for (const PackingRun& r : runs) {
+    s.seeds.push_back(r.seed);
+    e.push_back(r.ucs.r.youngs_modulus);
+    nu.push_back(r.ucs.r.poisson_ratio);
+    ucs.push_back(r.ucs.r.ucs);
+    t.push_back(r.br.r.tensile_strength);
+  }
+  s.E = property(std::move(e), tol, false);
+  s.nu = property(std::move(nu), nu_tol, true);
+  s.ucs = property(std::move(ucs), tol, false);
+  s.tensile = property(std::move(t), tol, false);
+  return s;
+}
+
+nlohmann::json packing_json(const PackingSpread& s, const std::vector<PackingRun>& runs) {
+  nlohmann::json j = {{"seeds", s.seeds}, {"within_tolerance", s.within()}};
+  for (const Row& r : rows(s))
+    j[r.json] = {{"values", r.p->values},       {"mean", r.p->mean},
+                 {"spread", r.p->spread},       {"spread_is_absolute", r.absolute},
+                 {"limit", r.p->limit},         {"within", r.p->within()}};
+  double seconds = 0;
+  for (const PackingRun& r : runs) seconds += r.ucs.seconds + r.br.seconds;
+  j["wall_seconds"] = seconds;
+  return j;
+}
+
+std::string packing_markdown(const PackingSpread& s) {
+  std::string md = "\n## Packing check\n\n";
+  md += fmt::format(
+      "The result's bond parameters on {} further specimen packings (calibrate.packing_check), "
+      "each carved from its own ball and named by the first seed of its packing (the fit's "
+      "follows calibrate.seed): the spread is the range over the {} packings (relative to their "
+      "mean; nu absolute), against the fit's tolerance.\n\n",
+      s.seeds.size() - 1, s.seeds.size());
+  md += "| property | ";
+  for (size_t k = 0; k < s.seeds.size(); ++k)
+    md += fmt::format("seed {}{} | ", s.seeds[k], k == 0 ? " (fit)" : "");
+  md += "mean | spread | tolerance | within |\n|---|";
+  for (size_t k = 0; k < s.seeds.size() + 4; ++k) md += "---|";
+  md += "\n";
+  for (const Row& r : rows(s)) {
+    md += fmt::format("| {}{} | ", r.name, *r.unit ? fmt::format(" ({})", r.unit) : "");
+    for (double v : r.p->values) md += fmt::format("{:.3g} | ", v * r.scale);
+    md += fmt::format("{:.3g} | {} | {} | {} |\n", r.p->mean * r.scale, spread_text(r),
+                      limit_text(r), r.p->within() ? "yes" : "**no**");
+  }
+  md += fmt::format("\nUCS / tensile: ");
+  for (size_t k = 0; k < s.seeds.size(); ++k)
+    md += fmt::format("{}{:.2f}", k ? ", " : "", s.ucs.values[k] / s.tensile.values[k]);
+  md += s.within()
+            ? ".\n\nWithin the tolerance: the fit describes the bonds, not one packing.\n"
+            : ".\n\n**Beyond the tolerance**: what the fit met on its packing, another packing of "
+              "the same size does not; raise calibrate.n_elements (larger specimens average more "
+              "contacts) before reading the result as the ore's.\n";
+  return md;
+}
+
+std::string packing_warning(const PackingSpread& s, long n_elements) {
+  if (s.within()) return "";
+  std::string what;
+  for (const Row& r : rows(s))
+    if (!r.p->within())
+      what += fmt::format("{}{} {} (tolerance {})", what.empty() ? "" : ", ", r.name,
+                          spread_text(r), limit_text(r));
+  return fmt::format(
+      "[calibrate] packing check: over {} packings of {} elements the result spreads beyond the "
+      "fit's tolerance in {}: the specimens are too small for it; raise calibrate.n_elements "
+      "(report.md, \"Packing check\")",
+      s.seeds.size(), n_elements, what);
+}
+
+}  // namespace mill::calibrate

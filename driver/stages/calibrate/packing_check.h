@@ -1,0 +1,62 @@
+// The packing check of the calibrate stage (docs/calibration.md, "Packing
+// check"): the result's UCS and Brazilian tests repeated on further specimen
+// packings (the next seed streams after calibrate.seed's), and how far E, nu, UCS and the
+// tensile strength spread between the packings. A fit meets the card on one
+// packing; when the packings spread by more than the fit's tolerance, that
+// is the packing's doing as much as the bonds', and the specimens are too
+// small for the tolerance (bench/README.md, "UCS/T of 10 at bond gap 1.4":
+// flat joints at bond gap 1.4 on 400-element specimens gave tensile
+// strengths of 4.8, 9.3 and 7.7 MPa on three packings with the same bonds).
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "stages/calibrate/fitting.h"
+#include "stages/calibrate/lab_runs.h"
+
+namespace mill::calibrate {
+
+// The result's two tests on one further packing.
+struct PackingRun {
+  long seed = 0;  // the packing's first seed (Specimen::seed)
+  UcsRun ucs;
+  BrazilianRun br;
+};
+
+// One property over the packings, the fit's own first.
+struct PackingProperty {
+  std::vector<double> values;  // the fit's packing, then each further one
+  double mean = 0;
+  // (max - min) / mean; for nu, max - min (absolute, as its tolerance)
+  double spread = 0;
+  double limit = 0;  // the fit's tolerance for this property (relative; nu absolute)
+  bool within() const { return spread <= limit; }
+};
+
+struct PackingSpread {
+  std::vector<long> seeds;  // the fit's seed first
+  PackingProperty E, nu, ucs, tensile;
+  // Every property within the fit's tolerance from packing to packing.
+  bool within() const { return E.within() && nu.within() && ucs.within() && tensile.within(); }
+};
+
+// The spread of the result `best` (fitted on the packing of `seed`) and its
+// runs on further packings; `tol` the fit's relative tolerance, `nu_tol`
+// its absolute one for nu. Throws std::invalid_argument without runs.
+PackingSpread packing_spread(const Iteration& best, long seed, const std::vector<PackingRun>& runs,
+                             double tol, double nu_tol);
+
+// report.json's "packing_check".
+nlohmann::json packing_json(const PackingSpread& s, const std::vector<PackingRun>& runs);
+
+// report.md's section "Packing check" (a heading, the table, the verdict).
+std::string packing_markdown(const PackingSpread& s);
+
+// The warning when the packings spread beyond the tolerance: names the
+// properties, their spread and the key that enlarges the specimens; "" when
+// within.
+std::string packing_warning(const PackingSpread& s, long n_elements);
+
+}  // namespace mill::calibrate
