@@ -171,6 +171,13 @@ void calibration_json(const fs::path& run, Problems* problems, json& h) {
                         {"targets", pick(cal, "targets")},
                         {"achieved", pick(cal, "achieved")},
                         {"within_tolerance", pick(cal, "within_tolerance")}};
+  // The packing check without its runs: each property's values and spread.
+  const json pc = cal.is_null() ? json() : pick(cal, "packing_check");
+  if (pc.is_object()) {
+    json c = pc;
+    c.erase("runs");
+    h["calibration"]["packing_check"] = c;
+  }
 }
 
 // headline.json's "breakage": critical speeds, comminution efficiency, JK fit.
@@ -432,6 +439,45 @@ void transport_rows(const json& h, const RowAdder& add) {
 }
 
 // The rows of the calibration: the bonds' source, or each target's result.
+// The packing check: the result on further specimen packings. Beyond the
+// tolerance it names each property's range (a brief row: what the fit met
+// on its packing, another does not); within, one line.
+void packing_row(const json& pc, const RowAdder& add) {
+  if (!pc.is_object() || !pick(pc, "seeds").is_array()) return;
+  const size_t n = pc.at("seeds").size();
+  struct P {
+    const char* key;
+    const char* what;
+    double scale;
+    const char* unit;
+  };
+  std::string ranges, tol;
+  for (const P& p : {P{"youngs_modulus", "E", 1e-9, " GPa"}, P{"poisson_ratio", "nu", 1, ""},
+                     P{"ucs", "UCS", 1e-6, " MPa"},
+                     P{"tensile_strength", "tensile strength", 1e-6, " MPa"}}) {
+    const json q = pick(pc, p.key);
+    if (!q.is_object() || !pick(q, "values").is_array() || pick(q, "values").empty()) continue;
+    if (tol.empty() && pick(q, "spread_is_absolute") == false && num(pick(q, "limit")))
+      tol = percent(d(q.at("limit")));
+    if (pick(q, "within") != false) continue;
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (const auto& v : q.at("values")) {
+      lo = std::min(lo, v.get<double>());
+      hi = std::max(hi, v.get<double>());
+    }
+    ranges += fmt::format("{}{} {}-{}{}", ranges.empty() ? "" : ", ", p.what, g3(lo * p.scale),
+                          g3(hi * p.scale), p.unit);
+  }
+  const std::string tol_text = tol.empty() ? "the fit's tolerance" : "the " + tol + " tolerance";
+  if (ranges.empty())
+    add(2, "calibration over specimen packings",
+        fmt::format("within {} over {} packings", tol_text, n), false);
+  else
+    add(2, "calibration over specimen packings",
+        fmt::format("{} over {} packings: beyond {}, the specimens are too small for it", ranges, n,
+                    tol_text));
+}
+
 void calibration_rows(const json& h, const RowAdder& add) {
   const json cal = pick(h, "calibration");
   if (cal.is_object()) {
@@ -458,6 +504,7 @@ void calibration_rows(const json& h, const RowAdder& add) {
                 (ok.is_boolean() ? (ok.get<bool>() ? ": met" : ": not met") : ""),
             p.brief);
       }
+      packing_row(pick(cal, "packing_check"), add);
     }
   }
 }

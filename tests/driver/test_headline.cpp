@@ -270,3 +270,32 @@ TEST(Headline, ClosedCircuitNamesThePeightyTheElementsSet) {
 }
 
 }  // namespace
+
+// The calibration's packing check (docs/calibration.md, "Packing check"):
+// beyond the tolerance the row names each property's range over the
+// packings (the default case's figures of Nov 28); within, one line.
+TEST(Headline, CalibrationOverSpecimenPackings) {
+  json h = json::parse(R"({
+    "calibration": {"source": "fitted", "targets": {"ucs": 50e6}, "achieved": {"ucs": 21.4e6},
+      "within_tolerance": {"ucs": false},
+      "packing_check": {"seeds": [34019, 34031, 34039], "within_tolerance": false,
+        "youngs_modulus": {"values": [19.6e9, 16.4e9, 14.6e9], "spread": 0.298, "limit": 0.1,
+                           "spread_is_absolute": false, "within": false},
+        "poisson_ratio": {"values": [0.182, 0.194, 0.207], "spread": 0.025, "limit": 0.05,
+                          "spread_is_absolute": true, "within": true},
+        "ucs": {"values": [21.4e6, 18.0e6, 15.2e6], "spread": 0.34, "limit": 0.1,
+                "spread_is_absolute": false, "within": false},
+        "tensile_strength": {"values": [5.15e6, 4.87e6, 4.45e6], "spread": 0.147, "limit": 0.1,
+                             "spread_is_absolute": false, "within": false}}}})");
+  auto rows = headline_rows(h);
+  EXPECT_EQ(value_of(rows, "calibration over specimen packings"),
+            "E 14.6-19.6 GPa, UCS 15.2-21.4 MPa, tensile strength 4.45-5.15 MPa over 3 packings: "
+            "beyond the 10% tolerance, the specimens are too small for it");
+  for (const char* k : {"youngs_modulus", "ucs", "tensile_strength"})
+    h["calibration"]["packing_check"][k]["within"] = true;
+  rows = headline_rows(h);
+  EXPECT_EQ(value_of(rows, "calibration over specimen packings"),
+            "within the 10% tolerance over 3 packings");
+  h["calibration"].erase("packing_check");  // a calibration before the check: no row
+  EXPECT_EQ(value_of(headline_rows(h), "calibration over specimen packings"), "");
+}
