@@ -19,6 +19,7 @@
 #include "stages/calibrate/fitting.h"
 #include "stages/calibrate/lab_runs.h"
 #include "stages/calibrate/outputs.h"
+#include "stages/calibrate/packing_check.h"
 #include "stages/calibrate/sensitivity.h"
 #include "stages/calibrate/specimen.h"
 #include "stages/calibrate/starts.h"
@@ -221,31 +222,8 @@ void Calibration::run() {
                       per_it * max_it_ / steps_total});
   // Packing check: the best parameters on further packings, each its own ball.
   const double after_rate = per_it * max_it_ + (rate_check ? 2.0 : 0.0);
-  for (int k = 1; k <= n_packings; ++k) {
-    PackingRun r;
-    const Specimen spk = pack_specimen(ctx_, job_.label, dir_, n_, k);
-    r.seed = spk.seed;
-    LabBench other(ctx_, job_.label, dir_, spk, t);
-    other.set_lanes(lab.lanes());
-    const BondParams& best = hist[o.best].p;
-    const double at = after_rate + 2.0 * (k - 1);
-    run_concurrently(
-        {[&] {
-           r.ucs = other.ucs(best, rate_,
-                             {fmt::format("packing{}_ucs", k),
-                              fmt::format("packing check {}/{}: UCS (seed {})", k, n_packings, r.seed),
-                              at / steps_total});
-         },
-         [&] {
-           r.br = other.brazilian(
-               best, rate_,
-               {fmt::format("packing{}_brazilian", k),
-                fmt::format("packing check {}/{}: Brazilian (seed {})", k, n_packings, r.seed),
-                (at + 1.0) / steps_total});
-         }},
-        other.lanes());
-    o.packings.push_back(std::move(r));
-  }
+  o.packings = run_packings(ctx_, job_.label, dir_, n_, n_packings, hist[o.best].p, t, rate_,
+                            lab.lanes(), after_rate / steps_total, 1.0 / steps_total);
   if (!o.packings.empty()) {
     o.packing =
         packing_spread(hist[o.best], o.specimen.seed, o.packings, fit_.tolerance(), kNuTolerance);

@@ -6,6 +6,9 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "stages/calibrate/specimen.h"
+#include "stages/stage_util.h"
+
 namespace mill::calibrate {
 
 namespace {
@@ -49,6 +52,37 @@ std::string limit_text(const Row& r) {
 }
 
 }  // namespace
+
+std::vector<PackingRun> run_packings(StageContext& ctx, const std::string& job_label,
+                                     const std::filesystem::path& dir, long n, int packings,
+                                     const BondParams& p, const Targets& t, double rate, int lanes,
+                                     double done, double step_share) {
+  std::vector<PackingRun> runs;
+  for (int k = 1; k <= packings; ++k) {
+    PackingRun r;
+    const Specimen sp = pack_specimen(ctx, job_label, dir, n, k);
+    r.seed = sp.seed;
+    LabBench lab(ctx, job_label, dir, sp, t);
+    lab.set_lanes(lanes);
+    const double at = done + 2.0 * (k - 1) * step_share;
+    const std::string of = fmt::format("packing check {}/{}", k, packings);
+    run_concurrently(
+        {[&] {
+           r.ucs = lab.ucs(p, rate,
+                           {fmt::format("packing{}_ucs", k),
+                            fmt::format("{}: UCS (seed {})", of, r.seed), at});
+         },
+         [&] {
+           r.br = lab.brazilian(p, rate,
+                                {fmt::format("packing{}_brazilian", k),
+                                 fmt::format("{}: Brazilian (seed {})", of, r.seed),
+                                 at + step_share});
+         }},
+        lab.lanes());
+    runs.push_back(std::move(r));
+  }
+  return runs;
+}
 
 PackingSpread packing_spread(const Iteration& best, long seed, const std::vector<PackingRun>& runs,
                              double tol, double nu_tol) {

@@ -9,12 +9,14 @@
 // strengths of 4.8, 9.3 and 7.7 MPa on three packings with the same bonds).
 #pragma once
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "stages/calibrate/fitting.h"
 #include "stages/calibrate/lab_runs.h"
+#include "stages/stage.h"
 
 namespace mill::calibrate {
 
@@ -24,6 +26,15 @@ struct PackingRun {
   UcsRun ucs;
   BrazilianRun br;
 };
+
+// The result's parameters p on `packings` further packings of n-element
+// specimens (pack_specimen's packings 1, 2, ...), each its own ball, with
+// targets t at strain rate `rate`: a UCS and a Brazilian test each, side by
+// side on `lanes` lanes; progress from `done`, `step_share` per test.
+std::vector<PackingRun> run_packings(StageContext& ctx, const std::string& job_label,
+                                     const std::filesystem::path& dir, long n, int packings,
+                                     const BondParams& p, const Targets& t, double rate, int lanes,
+                                     double done, double step_share);
 
 // One property over the packings, the fit's own first.
 struct PackingProperty {
