@@ -234,8 +234,8 @@ void Calibration::run() {
         100 * o.packing->ucs.spread, 100 * o.packing->tensile.spread));
     const std::string w = packing_warning(*o.packing, n_);
     if (!w.empty()) {
-      ctx_.progress.warn(w);
-      notes.push_back(w.substr(w.find(']') + 2));
+      ctx_.progress.warn("[calibrate] " + w);
+      notes.push_back(w);
     }
   }
   // Sensitivities: each lever stepped alone from the best parameters.

@@ -85,22 +85,6 @@ class Report {
 
  private:
   std::vector<std::string> explain_missed() const;
-  // report.json's packing_check: the spread and each further packing's runs
-  // (null without the check).
-  nlohmann::json packing_check_json() const {
-    if (!o_.packing) return nullptr;
-    nlohmann::json j = packing_json(*o_.packing, o_.packings);
-    nlohmann::json runs = nlohmann::json::array();
-    for (const PackingRun& r : o_.packings)
-      runs.push_back({{"seed", r.seed},
-                      {"ucs_run", r.ucs.tag},
-                      {"brazilian_run", r.br.tag},
-                      {"energy",
-                       {{"ucs", lab_energy_json(r.ucs.energy)},
-                        {"brazilian", lab_energy_json(r.br.energy)}}}});
-    j["runs"] = runs;
-    return j;
-  }
 
   const config::Document& d_;
   const config::Document& ore_;
@@ -301,7 +285,8 @@ nlohmann::json Report::json() const {
                                             {"energy", lab_energy_json(half_->energy)},
                                             {"wall_seconds", half_->seconds}}
                            : nlohmann::json(nullptr)},
-      {"packing_check", packing_check_json()},
+      {"packing_check",
+       o_.packing ? packing_json(*o_.packing, o_.packings) : nlohmann::json(nullptr)},
       {"sensitivity", o_.sensitivity.empty() ? nlohmann::json(nullptr)
                                              : sensitivity_json(b_, o_.sensitivity, tol_, noise_)},
       {"checks", checks_json(o_.checks, b_.ucs.r.ucs)},

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "stages/calibrate/energy_report.h"
 #include "stages/calibrate/specimen.h"
 #include "stages/stage_util.h"
 
@@ -112,8 +113,18 @@ nlohmann::json packing_json(const PackingSpread& s, const std::vector<PackingRun
                  {"spread", r.p->spread},       {"spread_is_absolute", r.absolute},
                  {"limit", r.p->limit},         {"within", r.p->within()}};
   double seconds = 0;
-  for (const PackingRun& r : runs) seconds += r.ucs.seconds + r.br.seconds;
+  nlohmann::json each = nlohmann::json::array();
+  for (const PackingRun& r : runs) {
+    seconds += r.ucs.seconds + r.br.seconds;
+    each.push_back({{"seed", r.seed},
+                    {"ucs_run", r.ucs.tag},
+                    {"brazilian_run", r.br.tag},
+                    {"energy",
+                     {{"ucs", lab_energy_json(r.ucs.energy)},
+                      {"brazilian", lab_energy_json(r.br.energy)}}}});
+  }
   j["wall_seconds"] = seconds;
+  j["runs"] = each;
   return j;
 }
 
@@ -156,7 +167,7 @@ std::string packing_warning(const PackingSpread& s, long n_elements) {
       what += fmt::format("{}{} {} (tolerance {})", what.empty() ? "" : ", ", r.name,
                           spread_text(r), limit_text(r));
   return fmt::format(
-      "[calibrate] packing check: over {} packings of {} elements the result spreads beyond the "
+      "packing check: over {} packings of {} elements the result spreads beyond the "
       "fit's tolerance in {}: the specimens are too small for it; raise calibrate.n_elements "
       "(report.md, \"Packing check\")",
       s.seeds.size(), n_elements, what);

@@ -59,15 +59,16 @@ struct PackingSpread {
 PackingSpread packing_spread(const Iteration& best, long seed, const std::vector<PackingRun>& runs,
                              double tol, double nu_tol);
 
-// report.json's "packing_check".
+// report.json's "packing_check": the spread, and each further packing's runs
+// with their energy ledgers.
 nlohmann::json packing_json(const PackingSpread& s, const std::vector<PackingRun>& runs);
 
 // report.md's section "Packing check" (a heading, the table, the verdict).
 std::string packing_markdown(const PackingSpread& s);
 
-// The warning when the packings spread beyond the tolerance: names the
-// properties, their spread and the key that enlarges the specimens; "" when
-// within.
+// The warning (and the report's note) when the packings spread beyond the
+// tolerance: names the properties, their spread and the key that enlarges
+// the specimens; "" when within.
 std::string packing_warning(const PackingSpread& s, long n_elements);
 
 }  // namespace mill::calibrate
