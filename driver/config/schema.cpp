@@ -495,7 +495,8 @@ std::vector<KeyDef> feed_keys() {
 std::vector<KeyDef> calibrate_keys() {
   return {
       // --- calibration (virtual lab tests) ---
-      range(key("calibrate.n_elements", T::Int, "", "1500", "Elements in a lab specimen"), 20, false, 1e7, false),
+      range(key("calibrate.n_elements", T::Int, "", "1500", "Elements in a lab specimen"), 20,
+            false, 1e7, false),
       positive(key("calibrate.strain_rate", T::Real, "1/s", "0.5",
                    "Platen strain rate of the UCS and Brazilian tests")),
       at_least(key("calibrate.max_iterations", T::Int, "", "8", "Calibration iterations cap"), 1),
@@ -503,42 +504,80 @@ std::vector<KeyDef> calibrate_keys() {
                    "Relative tolerance on E, UCS and tensile strength")),
       at_least(key("calibrate.seed", T::Int, "", "2002", "Seed of the specimen packing"), 1),
       range(key("calibrate.starts", T::Int, "", "1",
-                "Fits from different starts: 1 fits from the closed-form estimate; N > 1 adds N - 1 fits "
-                "from that estimate scaled within x/÷ 2 (Halton points), each a parameter set of its own "
-                "(calibrate/sets.json), and the breakage stage repeats its impacts with every set to give the "
-                "band of critical impact speeds the ore card leaves open (docs/calibration.md, \"Parameter "
-                "sets from different starts\"). Each start costs a fit; each set, the sweep's impacts again"),
+                "Fits from different starts: 1 fits from the closed-form estimate; N > 1 adds N - "
+                "1 fits "
+                "from that estimate scaled within x/÷ 2 (Halton points), each a parameter set of "
+                "its own "
+                "(calibrate/sets.json), and the breakage stage repeats its impacts with every set "
+                "to give the "
+                "band of critical impact speeds the ore card leaves open (docs/calibration.md, "
+                "\"Parameter "
+                "sets from different starts\"). Each start costs a fit; each set, the sweep's "
+                "impacts again"),
             1, false, 8, false),
       key("calibrate.fit_toughness", T::Bool, "", "true",
-          "With flat joints (lump.bond_model: flat_joint) and an ore card that gives fracture_toughness: "
-          "every iteration also runs the semi-circular bend test and the fit aims at K_IC as a fifth target "
-          "(its lever: the bond tensile strength against the cohesion). false: K_IC is a check after the "
-          "fit only, as it always is for the parallel bond (docs/calibration.md, \"The toughness as a "
+          "With flat joints (lump.bond_model: flat_joint) and an ore card that gives "
+          "fracture_toughness: "
+          "every iteration also runs the semi-circular bend test and the fit aims at K_IC as a "
+          "fifth target "
+          "(its lever: the bond tensile strength against the cohesion). false: K_IC is a check "
+          "after the "
+          "fit only, as it always is for the parallel bond (docs/calibration.md, \"The toughness "
+          "as a "
           "target\")"),
       range(key("calibrate.scb_orientations", T::Int, "", "6",
-                "With an ore card that gives fracture_toughness: half discs per semi-circular bend test, each "
-                "carved from the specimen ball turned a further 180 deg / N about the load axis; K_IC is their "
-                "mean, reported with its standard error and range. One half disc of a few hundred elements "
-                "scatters K_IC by tens of per cent with where its notch cuts the packing (docs/calibration.md, "
+                "With an ore card that gives fracture_toughness: half discs per semi-circular bend "
+                "test, each "
+                "carved from the specimen ball turned a further 180 deg / N about the load axis; "
+                "K_IC is their "
+                "mean, reported with its standard error and range. One half disc of a few hundred "
+                "elements "
+                "scatters K_IC by tens of per cent with where its notch cuts the packing "
+                "(docs/calibration.md, "
                 "\"The toughness as a target\"). Each half disc costs a few seconds per bend test"),
             1, false, 12, false),
       key("calibrate.rate_check", T::Bool, "", "true",
           "After the fit, repeat the UCS test at half the strain rate (quasi-static check)"),
+      range(key("calibrate.fit_packings", T::Int, "", "1",
+                "Specimen packings each iteration of the fit tests, each carved from its own ball "
+                "(the seed "
+                "streams after calibrate.seed's): the fit aims the means of E, nu, UCS and the "
+                "tensile strength "
+                "over them at the ore card, as a lab reads several specimens. A specimen of a few "
+                "hundred "
+                "elements spreads by tens of per cent from packing to packing "
+                "(calibrate.packing_check); the mean "
+                "of N spreads about 1/sqrt(N) as much (docs/calibration.md, \"Fitting the mean of "
+                "several "
+                "packings\"). Each packing costs the iteration's UCS and Brazilian tests again; "
+                "the rate check, "
+                "sensitivities and checks stay on the first packing"),
+            1, false, 8, false),
       range(key("calibrate.packing_check", T::Int, "", "2",
-                "After the fit, repeat the result's UCS and Brazilian tests on this many further specimen "
-                "packings (the seed streams after calibrate.seed's) and report how far E, nu, UCS and the tensile "
-                "strength spread between the packings; beyond the fit's tolerance it warns that the "
+                "After the fit, repeat the result's UCS and Brazilian tests on this many further "
+                "specimen "
+                "packings (the seed streams after calibrate.seed's) and report how far E, nu, UCS "
+                "and the tensile "
+                "strength spread between the packings (the fit's own packings included); beyond "
+                "the fit's tolerance it "
+                "warns that the "
                 "specimens are too small (docs/calibration.md, \"Packing check\"). 0: no check"),
             0, false, 8, false),
       key("calibrate.sensitivity", T::Bool, "", "true",
-          "After the fit, step each fitted bond parameter alone from the result (x1.2; friction angle +5 deg; "
-          "moment factor -0.25) in one UCS + Brazilian pair each and report each lever's sensitivity (the "
-          "change in each target per change in the lever) and which levers move no target (docs/calibration.md, "
+          "After the fit, step each fitted bond parameter alone from the result (x1.2; friction "
+          "angle +5 deg; "
+          "moment factor -0.25) in one UCS + Brazilian pair each and report each lever's "
+          "sensitivity (the "
+          "change in each target per change in the lever) and which levers move no target "
+          "(docs/calibration.md, "
           "\"Lever sensitivities\")"),
       range(key("calibrate.confining_pressures", T::RealList, "x ucs", "[0.1, 0.2]",
-                "After the fit, one triaxial test per entry at this confining pressure (a fraction of the UCS "
-                "the result reached: the card's ucs when met) with the result's bond parameters: the failure "
-                "envelope, a check, not fitted. At most 1/4: above it the virtual test leaves the Mohr-Coulomb "
+                "After the fit, one triaxial test per entry at this confining pressure (a fraction "
+                "of the UCS "
+                "the result reached: the card's ucs when met) with the result's bond parameters: "
+                "the failure "
+                "envelope, a check, not fitted. At most 1/4: above it the virtual test leaves the "
+                "Mohr-Coulomb "
                 "line (docs/calibration.md)"),
             0, true, 0.25, false)};
 }

@@ -9,6 +9,9 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <functional>
+#include <utility>
+#include <vector>
 
 #include "jobs/job_store.h"
 #include "jobs/output_checks.h"
@@ -91,6 +94,7 @@ class Calibration {
     rate_ = d_.real("calibrate.strain_rate");
     max_it_ = static_cast<int>(d_.integer("calibrate.max_iterations"));
     scb_orientations_ = static_cast<int>(d_.integer("calibrate.scb_orientations"));
+    fit_packings_ = static_cast<int>(d_.integer("calibrate.fit_packings"));
   }
 
   // The whole calibration: specimen, iterations, rate check, outputs.
@@ -108,6 +112,7 @@ class Calibration {
   long n_ = 0;
   int max_it_ = 1;
   int scb_orientations_ = 1;  // half discs of each bend test
+  int fit_packings_ = 1;      // specimen packings each iteration tests (the fit reads their means)
 };
 
 // The calibration: pack, iterate the two tests, check the rate, step each
@@ -130,6 +135,15 @@ void Calibration::run() {
   // fits (the stage's jobs, which the pipeline runs side by side): the rest
   // go to this fit's independent tests (docs/calibration.md, "Runs at once").
   lab.set_lanes(ctx_.opts.jobs / std::max<int>(1, static_cast<int>(d_.integer("calibrate.starts"))));
+  // The fit's further packings (calibrate.fit_packings): each its own ball,
+  // the same tests in every iteration; the fit reads the means.
+  std::vector<LabBench> more;
+  std::vector<long> more_seeds;
+  for (int k = 1; k < fit_packings_; ++k) {
+    const Specimen spk = pack_specimen(ctx_, job_.label, dir_, n_, k);
+    more.emplace_back(ctx_, job_.label, dir_, spk, t);
+    more_seeds.push_back(spk.seed);
+  }
   std::vector<Iteration>& hist = o.hist;
   std::vector<std::string>& notes = o.notes;
   BondParams p = estimate_bond_params(ore_, d_);
@@ -165,40 +179,59 @@ void Calibration::run() {
   const int n_packings = primary ? static_cast<int>(d_.integer("calibrate.packing_check")) : 0;
   const double n_sensitivity =
       sensitivity ? 2.0 * static_cast<double>(sensitivity_levers(p).size()) : 0.0;
-  const double per_it = fit_.fits_toughness() ? 3.0 : 2.0;
+  const double per_it = 2.0 * fit_packings_ + (fit_.fits_toughness() ? 1.0 : 0.0);
   const double steps_total =
       per_it * max_it_ + (rate_check ? 2.0 : 0.0) + 2.0 * n_packings + n_sensitivity + n_checks;
   for (int k = 1; k <= max_it_; ++k) {
     Iteration it;
     it.p = p;
-    // The UCS and the Brazilian test side by side when the job has two lanes.
-    run_concurrently(
-        {[&] {
-           it.ucs = lab.ucs(
-               p, rate_,
-               {fmt::format("it{}_ucs", k), fmt::format("iteration {}/{}: UCS", k, max_it_),
-                (per_it * (k - 1)) / steps_total});
-         },
-         [&] {
-           it.br = lab.brazilian(p, rate_,
-                                 {fmt::format("it{}_brazilian", k),
-                                  fmt::format("iteration {}/{}: Brazilian", k, max_it_),
-                                  (per_it * (k - 1) + 1) / steps_total});
-         }},
-        lab.lanes());
+    it.more.resize(more.size());
+    // The UCS and the Brazilian test of every packing, side by side as the
+    // job's lanes allow.
+    const double at = per_it * (k - 1);
+    std::vector<std::function<void()>> tests = {
+        [&] {
+          it.ucs = lab.ucs(p, rate_,
+                           {fmt::format("it{}_ucs", k),
+                            fmt::format("iteration {}/{}: UCS", k, max_it_), at / steps_total});
+        },
+        [&] {
+          it.br = lab.brazilian(
+              p, rate_,
+              {fmt::format("it{}_brazilian", k),
+               fmt::format("iteration {}/{}: Brazilian", k, max_it_), (at + 1) / steps_total});
+        }};
+    for (size_t j = 0; j < more.size(); ++j) {
+      const std::string of =
+          fmt::format("iteration {}/{}, packing {}/{}", k, max_it_, j + 2, fit_packings_);
+      const double at_j = at + 2.0 * static_cast<double>(j + 1);
+      it.more[j].seed = more_seeds[j];
+      tests.push_back([&, j, of, at_j] {
+        it.more[j].ucs = more[j].ucs(
+            p, rate_, {fmt::format("it{}_p{}_ucs", k, j + 2), of + ": UCS", at_j / steps_total});
+      });
+      tests.push_back([&, j, of, at_j] {
+        it.more[j].br = more[j].brazilian(p, rate_,
+                                          {fmt::format("it{}_p{}_brazilian", k, j + 2),
+                                           of + ": Brazilian", (at_j + 1) / steps_total});
+      });
+    }
+    run_concurrently(tests, lab.lanes());
     if (fit_.fits_toughness())
       it.scb = lab.scb(p, rate_, scb_orientations_,
                        {fmt::format("it{}_scb", k),
                         fmt::format("iteration {}/{}: semi-circular bend", k, max_it_),
-                        (per_it * (k - 1) + 2) / steps_total});
+                        (at + 2.0 * fit_packings_) / steps_total});
     fit_.score(it);
     hist.push_back(it);
+    const Measured m = it.measured();
     ctx_.progress.info(fmt::format(
         "[calibrate] iteration {}/{}: E {:.2f} GPa (target {:.2f}), nu {:.3f} ({:.2f}), UCS {:.1f} "
         "MPa ({:.1f}), tensile "
-        "{:.2f} MPa ({:.2f}){}{} [{:.0f} s + {:.0f} s{}]",
-        k, max_it_, it.ucs.r.youngs_modulus / 1e9, t.E / 1e9, it.ucs.r.poisson_ratio, t.nu,
-        it.ucs.r.ucs / 1e6, t.ucs / 1e6, it.br.r.tensile_strength / 1e6, t.tensile / 1e6,
+        "{:.2f} MPa ({:.2f}){}{}{} [{:.0f} s + {:.0f} s{}]",
+        k, max_it_, m.E / 1e9, t.E / 1e9, m.nu, t.nu, m.ucs / 1e6, t.ucs / 1e6, m.tensile / 1e6,
+        t.tensile / 1e6,
+        more.empty() ? "" : fmt::format(" (means over {} packings)", fit_packings_),
         it.scb ? fmt::format(", K_IC {} ({:.3f})", it.scb->summary(), t.toughness / 1e6) : "",
         it.converged ? ": all within tolerance" : "", it.ucs.seconds, it.br.seconds,
         it.scb ? fmt::format(" + {:.0f} s", it.scb->seconds) : ""));
@@ -211,6 +244,12 @@ void Calibration::run() {
     if (!it.br.peaked)
       notes.push_back(
           fmt::format("iteration {}: the Brazilian test reached its cap still loading", k));
+    for (const PackingRun& r : it.more)
+      for (const auto& [done, test] : {std::pair{r.ucs.peaked, "UCS"}, {r.br.peaked, "Brazilian"}})
+        if (!done)
+          notes.push_back(fmt::format(
+              "iteration {}: the {} test on packing seed {} reached its cap still loading", k, test,
+              r.seed));
     if (it.converged || k == max_it_) break;
     p = fit_.update(hist, notes);
   }
@@ -222,9 +261,10 @@ void Calibration::run() {
                       per_it * max_it_ / steps_total});
   // Packing check: the best parameters on further packings, each its own ball.
   const double after_rate = per_it * max_it_ + (rate_check ? 2.0 : 0.0);
-  o.packings = run_packings(ctx_, job_.label, dir_, n_, n_packings, hist[o.best].p, t, rate_,
-                            lab.lanes(), after_rate / steps_total, 1.0 / steps_total);
-  if (!o.packings.empty()) {
+  o.packings = run_packings(ctx_, job_.label, dir_, n_, fit_packings_, n_packings, hist[o.best].p,
+                            t, rate_, lab.lanes(), after_rate / steps_total, 1.0 / steps_total);
+  // The spread over the fit's packings and the check's (with one in all: none).
+  if (primary && (!o.packings.empty() || fit_packings_ > 1)) {
     o.packing =
         packing_spread(hist[o.best], o.specimen.seed, o.packings, fit_.tolerance(), kNuTolerance);
     ctx_.progress.info(fmt::format(
@@ -315,6 +355,9 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
   // The number of starts is not an input of any one fit (the primary fit
   // keeps its job id whatever calibrate.starts is).
   in.erase("calibrate.starts");
+  // One packing per iteration, as before the key: the job id a calibration
+  // made then keeps.
+  if (ctx.cfg.doc.integer("calibrate.fit_packings") == 1) in.erase("calibrate.fit_packings");
   // The toughness fit is an input only where it acts (flat joints, a card
   // with K_IC): a parallel-bond calibration keeps its job id.
   if (!fits_toughness(ctx.cfg)) in.erase("calibrate.fit_toughness");
@@ -341,9 +384,13 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
         "tests";
   }
   // The tests of each iteration (the toughness fit adds the bend test).
-  const char* tests = fits_toughness(ctx.cfg) ? "UCS + Brazilian + semi-circular bend tests (K_IC a "
-                                                "target)"
-                                              : "UCS + Brazilian tests";
+  const long fit_packings = ctx.cfg.doc.integer("calibrate.fit_packings");
+  const std::string tests =
+      std::string(fits_toughness(ctx.cfg) ? "UCS + Brazilian + semi-circular bend tests (K_IC a "
+                                            "target)"
+                                          : "UCS + Brazilian tests") +
+      (fit_packings > 1 ? fmt::format(" on {} packings (their means fitted)", fit_packings)
+                        : std::string());
   p.jobs.push_back(
       {"calibration", in,
        from_card

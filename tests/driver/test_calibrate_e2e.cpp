@@ -296,6 +296,67 @@ TEST_F(TinyCalibration, TwoLanesGiveTheSameCalibrationWithTestsSideBySide) {
   EXPECT_LT(started("it1_brazilian", "brazilian_info.txt"), started("it1_ucs", "liggghts.log"));
 }
 
+// calibrate.fit_packings 2: every iteration tests two packings and the fit
+// reads their means (the achieved properties are the arithmetic means of
+// the two packings' to the last digit); the packing check's table starts
+// with both; the one-packing fit of the fixture keeps its job id (the key
+// is not among its inputs).
+TEST_F(TinyCalibration, FitOnTwoPackingsAimsTheirMeansAtTheCard) {
+  ASSERT_EQ(status_, 0) << slurp(*dir_ / "first.log");
+  const auto dir = scratch("tiny_fit_packings");
+  spit(dir / "case.yaml",
+       "name: tiny_fit_packings\nore: {card: sandstone}\nlump: {n_elements: 150, diameter: 0.02, "
+       "bond_gap: 0.2}\ncalibrate: {n_elements: 200, max_iterations: 1, strain_rate: 2.0, seed: "
+       "2003, fit_packings: 2, packing_check: 1, rate_check: false, sensitivity: false, "
+       "confining_pressures: [0.1], scb_orientations: 1}\nresources: {np: 1, jobs: 2}\n");
+  ASSERT_EQ(orchestrate("--case " + (dir / "case.yaml").string() + " --stage calibrate --output " +
+                            dir.string(),
+                        dir / "log"),
+            0)
+      << slurp(dir / "log");
+  const fs::path job = dir / "calibrate" / "jobs" / "calibration";
+  const auto r = read_json(job / "report.json");
+  const auto& packings = r["iterations"][0]["packings"];
+  ASSERT_EQ(packings.size(), 2u) << r["iterations"][0].dump(1);
+  EXPECT_NE(packings[0]["seed"], packings[1]["seed"]);
+  EXPECT_TRUE(fs::exists(job / "runs" / "it1_p2_ucs" / "ledger.csv"));
+  EXPECT_TRUE(fs::exists(job / "runs" / "it1_p2_brazilian" / "ledger.csv"));
+  for (const char* k : {"youngs_modulus", "poisson_ratio", "ucs", "tensile_strength"}) {
+    const double a = packings[0][k].get<double>(), b = packings[1][k].get<double>();
+    EXPECT_NE(a, b) << k << ": two packings, one value";
+    const double mean = 0.5 * (a + b);
+    EXPECT_NEAR(r["iterations"][0]["achieved"][k].get<double>(), mean, 1e-12 * std::abs(mean)) << k;
+    EXPECT_NEAR(r["achieved"][k].get<double>(), mean, 1e-12 * std::abs(mean)) << k;
+  }
+  // The errors are the means' against the card.
+  const double t_mean = r["achieved"]["tensile_strength"].get<double>(),
+               t_card = r["targets"]["tensile_strength"].get<double>();
+  EXPECT_NEAR(r["iterations"][0]["errors"]["tensile_strength"].get<double>(),
+              std::abs(t_mean - t_card) / t_card, 1e-9);
+  // The packing check: the fit's two packings, then the further one.
+  const auto& pc = r["packing_check"];
+  EXPECT_EQ(pc["fit_packings"].get<int>(), 2);
+  ASSERT_EQ(pc["seeds"].size(), 3u) << pc.dump(1);
+  EXPECT_EQ(pc["seeds"][0], packings[0]["seed"]);
+  EXPECT_EQ(pc["seeds"][1], packings[1]["seed"]);
+  EXPECT_NE(pc["seeds"][2], pc["seeds"][0]);
+  EXPECT_NE(pc["seeds"][2], pc["seeds"][1]);
+  EXPECT_EQ(pc["tensile_strength"]["values"][1], packings[1]["tensile_strength"]);
+  // Every run's ledger: 4 (the iteration) + 2 (the check) + 1 triaxial + 1 half disc.
+  EXPECT_EQ(r["energy"]["lab_runs"].get<int>(), 8) << r["energy"].dump();
+  const std::string md = slurp(job / "report.md");
+  EXPECT_NE(md.find("the means over the fit's 2 specimen packings"), std::string::npos) << md;
+  EXPECT_NE(
+      md.find(fmt::format("seed {} (fit) | seed {} (fit) | seed {} |", pc["seeds"][0].get<long>(),
+                          pc["seeds"][1].get<long>(), pc["seeds"][2].get<long>())),
+      std::string::npos)
+      << md;
+  EXPECT_EQ(read_json(job / "job.json")["inputs"]["calibrate.fit_packings"].get<int>(), 2);
+  EXPECT_FALSE(
+      read_json(*dir_ / "calibrate" / "jobs" / "calibration" / "job.json")["inputs"].contains(
+          "calibrate.fit_packings"));
+}
+
 // A card whose calibrated.* section does not match its properties (stale
 // input_hash): the fit starts from that section. Used here to start from
 // chosen parameters.

@@ -2,6 +2,7 @@
 // spread of the result over further specimen packings, by hand.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -98,4 +99,77 @@ TEST(CalibratePacking, WithinWhenEveryPropertyIsWithinItsTolerance) {
 TEST(CalibratePacking, NoRunsIsAnError) {
   EXPECT_THROW(mill::calibrate::packing_spread(result(1, 0.2, 1, 1), 1, {}, 0.1, 0.05),
                std::invalid_argument);
+}
+
+// calibrate.fit_packings: what the fit reads of an iteration is the mean
+// over its packings, by hand; a failed packing leaves the mean unusable;
+// one packing is read as it is.
+TEST(CalibratePacking, FitReadsTheMeansOverItsPackings) {
+  Iteration it = result(19.0e9, 0.159, 49.3e6, 4.81e6);
+  const mill::calibrate::Measured one = it.measured();
+  EXPECT_EQ(one.E, 19.0e9);
+  EXPECT_EQ(one.tensile, 4.81e6);
+  it.more = {run(2003, 17.6e9, 0.122, 44.7e6, 9.28e6), run(2004, 19.5e9, 0.184, 65.1e6, 7.74e6)};
+  const mill::calibrate::Measured m = it.measured();
+  EXPECT_NEAR(m.E, 18.7e9, 1e-6);
+  EXPECT_NEAR(m.nu, 0.155, 1e-15);
+  EXPECT_NEAR(m.ucs, 53.0333333e6, 1);
+  EXPECT_NEAR(m.tensile, 7.2766667e6, 1);
+  // Scored on the means: the sandstone's T 5.0 MPa is 45.5 % off the mean
+  // (the first packing alone: 3.8 %), E 20 GPa 6.5 %.
+  mill::calibrate::Fitting fit({20e9, 0.15, 50e6, 5e6}, 0.1);
+  fit.score(it);
+  EXPECT_NEAR(it.err_t, 2.2766667 / 5.0, 1e-7);
+  EXPECT_NEAR(it.err_E, 1.3 / 20.0, 1e-12);
+  EXPECT_NEAR(it.err_nu, 0.005, 1e-12);
+  EXPECT_FALSE(it.converged);
+  EXPECT_TRUE(mill::calibrate::Fitting::usable(it));
+  // A packing whose UCS test failed (negative modulus): no usable mean.
+  it.more[1].ucs.r.youngs_modulus = -3e9;
+  EXPECT_TRUE(std::isnan(it.measured().E));
+  EXPECT_FALSE(mill::calibrate::Fitting::usable(it));
+  // Two packings that straddle the card meet it on their mean.
+  Iteration straddle = result(20e9, 0.15, 60e6, 4.5e6);
+  straddle.more = {run(7, 20e9, 0.15, 42e6, 5.4e6)};
+  fit.score(straddle);
+  EXPECT_NEAR(straddle.err_ucs, 0.02, 1e-12);
+  EXPECT_NEAR(straddle.err_t, 0.01, 1e-12);
+  EXPECT_TRUE(straddle.converged);
+}
+
+// The packing check of a fit on three packings: its table and spread start
+// with the fit's own packings (marked "(fit)"), a further packing follows;
+// with no further packing the fit's own three still give a spread; the
+// warning points at calibrate.fit_packings only when the fit read one.
+TEST(CalibratePacking, SpreadOfAFitOnSeveralPackings) {
+  Iteration best = result(19.0e9, 0.159, 49.3e6, 4.81e6);
+  best.more = {run(2003, 17.6e9, 0.122, 44.7e6, 9.28e6), run(2004, 19.5e9, 0.184, 65.1e6, 7.74e6)};
+  const auto s =
+      mill::calibrate::packing_spread(best, 2002, {run(2005, 18.0e9, 0.15, 50e6, 6e6)}, 0.1, 0.05);
+  EXPECT_EQ(s.fit_packings, 3u);
+  EXPECT_EQ(s.seeds, (std::vector<long>{2002, 2003, 2004, 2005}));
+  EXPECT_EQ(s.tensile.values, (std::vector<double>{4.81e6, 9.28e6, 7.74e6, 6e6}));
+  EXPECT_NEAR(s.tensile.mean, (4.81 + 9.28 + 7.74 + 6) / 4 * 1e6, 1);
+  const std::string md = mill::calibrate::packing_markdown(s);
+  EXPECT_NE(md.find("| seed 2002 (fit) | seed 2003 (fit) | seed 2004 (fit) | seed 2005 | mean |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("1 further specimen packings (calibrate.packing_check) and the fit's own 3"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("the fit met the card on the mean of its packings"), std::string::npos) << md;
+  const std::string w = mill::calibrate::packing_warning(s, 400);
+  EXPECT_NE(w.find("4 packings of 400 elements"), std::string::npos) << w;
+  EXPECT_EQ(w.find("calibrate.fit_packings"), std::string::npos) << w;
+  const auto own = mill::calibrate::packing_spread(best, 2002, {}, 0.1, 0.05);
+  EXPECT_EQ(own.seeds, (std::vector<long>{2002, 2003, 2004}));
+  EXPECT_NEAR(own.tensile.spread, (9.28 - 4.81) / 7.2766667, 1e-6);
+  const auto j = mill::calibrate::packing_json(own, {});
+  EXPECT_EQ(j.at("fit_packings").get<int>(), 3);
+  // A fit on one packing: the warning names both ways out.
+  const auto single =
+      mill::calibrate::packing_spread(result(19.0e9, 0.159, 49.3e6, 4.81e6), 2002,
+                                      {run(2003, 17.6e9, 0.122, 44.7e6, 9.28e6)}, 0.1, 0.05);
+  EXPECT_NE(mill::calibrate::packing_warning(single, 400).find("calibrate.fit_packings"),
+            std::string::npos);
 }

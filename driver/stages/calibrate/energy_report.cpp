@@ -35,13 +35,18 @@ nlohmann::json lab_energy_json(const post::LedgerSummary& e) {
           {"end_time_s", e.end_time_s}};
 }
 
-// Iterations in order, each UCS then Brazilian, the rate check, the packing
+// Iterations in order, each UCS then Brazilian (then those of the fit's
+// further packings), the rate check, the packing
 // check's pairs, the levers' sensitivity pairs, then the checks.
 std::vector<const LabRun*> lab_runs(const Outcome& o) {
   std::vector<const LabRun*> runs;
   for (const Iteration& it : o.hist) {
     runs.push_back(&it.ucs);
     runs.push_back(&it.br);
+    for (const PackingRun& p : it.more) {
+      runs.push_back(&p.ucs);
+      runs.push_back(&p.br);
+    }
     if (it.scb)
       for (const ScbDisc& d : it.scb->discs) runs.push_back(&d);
   }
@@ -74,7 +79,8 @@ nlohmann::json energy_summary_json(const Outcome& o) {
        {{"ledgers",
          "jobs/calibration/runs/<run>/ledger.csv (fix energy/ledger, "
          "docs/styles/fix_energy_ledger.md); each run's figures are in its `energy` object "
-         "(iterations[].energy.ucs, .brazilian, rate_check.energy, packing_check.runs[].energy, "
+         "(iterations[].energy.ucs, .brazilian, iterations[].packings[].energy, rate_check.energy, "
+         "packing_check.runs[].energy, "
          "sensitivity.levers.<lever>.energy, checks.triaxial[].energy, checks.scb.discs[].energy)"},
         {"work_other_J",
          "the platens' drive: work done on the specimen by the moving platens (triaxial: and by "

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 
@@ -13,12 +14,45 @@
 
 namespace mill::calibrate {
 
+namespace {
+
+// The mean of one response over the packings; NaN when a packing's is not
+// finite (or, for a modulus or strength, not > 0): a failed test leaves the
+// mean unusable (Fitting::usable), as it leaves a single test.
+double mean_of(const std::vector<double>& v, bool positive) {
+  double sum = 0;
+  for (double x : v) {
+    if (!std::isfinite(x) || (positive && x <= 0)) return std::numeric_limits<double>::quiet_NaN();
+    sum += x;
+  }
+  return sum / static_cast<double>(v.size());
+}
+
+}  // namespace
+
+// The arithmetic means over the packings: a lab's reading of several
+// specimens. With one packing its own values, whatever they are.
+Measured Iteration::measured() const {
+  if (more.empty())
+    return {ucs.r.youngs_modulus, ucs.r.poisson_ratio, ucs.r.ucs, br.r.tensile_strength};
+  std::vector<double> E{ucs.r.youngs_modulus}, nu{ucs.r.poisson_ratio}, u{ucs.r.ucs},
+      t{br.r.tensile_strength};
+  for (const PackingRun& r : more) {
+    E.push_back(r.ucs.r.youngs_modulus);
+    nu.push_back(r.ucs.r.poisson_ratio);
+    u.push_back(r.ucs.r.ucs);
+    t.push_back(r.br.r.tensile_strength);
+  }
+  return {mean_of(E, true), mean_of(nu, false), mean_of(u, true), mean_of(t, true)};
+}
+
 // Errors of one iteration against the ore card and whether all are met.
 void Fitting::score(Iteration& it) const {
-  it.err_E = post::RelativeError(it.ucs.r.youngs_modulus, t_.E);
-  it.err_ucs = post::RelativeError(it.ucs.r.ucs, t_.ucs);
-  it.err_t = post::RelativeError(it.br.r.tensile_strength, t_.tensile);
-  it.err_nu = std::abs(it.ucs.r.poisson_ratio - t_.nu);
+  const Measured m = it.measured();
+  it.err_E = post::RelativeError(m.E, t_.E);
+  it.err_ucs = post::RelativeError(m.ucs, t_.ucs);
+  it.err_t = post::RelativeError(m.tensile, t_.tensile);
+  it.err_nu = std::abs(m.nu - t_.nu);
   // K_IC: a target only with the toughness fit; an iteration without its
   // bend test then misses it.
   it.err_kic = !fits_toughness() ? 0.0
@@ -40,8 +74,9 @@ Vec4 params_of(const BondParams& p) {
 // The responses of an iteration (local_model.h): the four macro targets
 // and ln K_IC (0 without a bend test: then not a target, weight 0).
 FitVec responses_of(const Iteration& it) {
-  return {std::log(it.ucs.r.youngs_modulus), it.ucs.r.poisson_ratio, std::log(it.ucs.r.ucs),
-          std::log(it.br.r.tensile_strength), it.scb ? std::log(it.scb->toughness) : 0.0};
+  const Measured m = it.measured();
+  return {std::log(m.E), m.nu, std::log(m.ucs), std::log(m.tensile),
+          it.scb ? std::log(it.scb->toughness) : 0.0};
 }
 
 // True when two iterations were made with the same coarse levers (moment
@@ -106,7 +141,7 @@ BondParams Fitting::joint_update(const std::vector<Iteration>& hist,
   const Iteration& now = hist.back();
   BondParams p = now.p;
   const double want = t_.ucs / t_.tensile;
-  const double have = now.ucs.r.ucs / now.br.r.tensile_strength;
+  const double have = now.measured().ucs / now.measured().tensile;
   // The local model from the last kModelPoints iterations (far points bend
   // a linear model).
   std::vector<ModelPointN<kFitResponses>> pts;
@@ -180,6 +215,8 @@ BondParams Fitting::secant_update(const std::vector<Iteration>& hist,
     prev = nullptr;
   auto pt = [](double x, double y) { return post::SecantPoint{x, y}; };
   auto prev_pt = [&](double x, double y) -> std::optional<post::SecantPoint> { return pt(x, y); };
+  const Measured m = now.measured();
+  const Measured mp = prev ? prev->measured() : Measured{};  // read only when prev
   BondParams p = now.p;
   // E scales with the bond modulus (all bond springs do), so the slope is near 1.
   const post::SecantRule e_rule{true, 1.0, 0.5, 1.5, std::log(4.0)};
@@ -188,20 +225,17 @@ BondParams Fitting::secant_update(const std::vector<Iteration>& hist,
   // Strengths scale with bond strengths when the failure mode stays the same
   // (the closed-form start can be an order of magnitude off: wide cap).
   const post::SecantRule s_rule{true, 1.0, 0.3, 2.0, std::log(16.0)};
-  p.modulus = post::SecantUpdate(
-                  e_rule, pt(now.p.modulus, now.ucs.r.youngs_modulus),
-                  prev ? prev_pt(prev->p.modulus, prev->ucs.r.youngs_modulus) : std::nullopt, t_.E)
+  p.modulus = post::SecantUpdate(e_rule, pt(now.p.modulus, m.E),
+                                 prev ? prev_pt(prev->p.modulus, mp.E) : std::nullopt, t_.E)
                   .x_new;
   p.stiffness_ratio = std::clamp(
-      post::SecantUpdate(
-          nu_rule, pt(now.p.stiffness_ratio, now.ucs.r.poisson_ratio),
-          prev ? prev_pt(prev->p.stiffness_ratio, prev->ucs.r.poisson_ratio) : std::nullopt, t_.nu)
+      post::SecantUpdate(nu_rule, pt(now.p.stiffness_ratio, m.nu),
+                         prev ? prev_pt(prev->p.stiffness_ratio, mp.nu) : std::nullopt, t_.nu)
           .x_new,
       0.5, 20.0);
   p.tensile =
-      post::SecantUpdate(
-          s_rule, pt(now.p.tensile, now.br.r.tensile_strength),
-          prev ? prev_pt(prev->p.tensile, prev->br.r.tensile_strength) : std::nullopt, t_.tensile)
+      post::SecantUpdate(s_rule, pt(now.p.tensile, m.tensile),
+                         prev ? prev_pt(prev->p.tensile, mp.tensile) : std::nullopt, t_.tensile)
           .x_new;
   // The UCS/tensile ratio: once E and the tensile strength are within
   // tolerance (most sensitive first), one lever per iteration, in the order
@@ -215,7 +249,7 @@ BondParams Fitting::secant_update(const std::vector<Iteration>& hist,
   const double ratio_now = now.p.cohesion / now.p.tensile;
   double ratio = ratio_now;
   const double want = t_.ucs / t_.tensile;
-  const double have = now.ucs.r.ucs / now.br.r.tensile_strength;
+  const double have = m.ucs / m.tensile;
   if (now.err_E <= tol_ && now.err_t <= tol_ && post::RelativeError(have, want) > tol_) {
     // The moment factor and friction-angle moves are coarse (each raised the
     // ratio by ~20 %): used only for a gap larger than that, else the cohesion.
@@ -235,11 +269,11 @@ BondParams Fitting::secant_update(const std::vector<Iteration>& hist,
       const post::SecantRule c_rule{true, 1.0, 0.5, 2.0, std::log(2.0)};
       const bool prev_moved =
           prev && std::abs(std::log(prev->p.cohesion / prev->p.tensile / ratio_now)) > 1e-6;
-      ratio = post::SecantUpdate(c_rule, pt(ratio_now, have),
-                                 prev_moved ? prev_pt(prev->p.cohesion / prev->p.tensile,
-                                                      prev->ucs.r.ucs / prev->br.r.tensile_strength)
-                                            : std::nullopt,
-                                 want)
+      ratio = post::SecantUpdate(
+                  c_rule, pt(ratio_now, have),
+                  prev_moved ? prev_pt(prev->p.cohesion / prev->p.tensile, mp.ucs / mp.tensile)
+                             : std::nullopt,
+                  want)
                   .x_new;
     }
   }
@@ -263,6 +297,7 @@ BondParams Fitting::update(const std::vector<Iteration>& hist,
   for (const auto& it : hist)
     if (usable(it)) good.push_back(it);
   const Iteration& last = hist.back();
+  const Measured lm = last.measured();
   if (!usable(last)) {
     // A response no model can use: step back half way (in log space) from
     // this iteration's parameters towards the last usable iteration's, with
@@ -273,8 +308,7 @@ BondParams Fitting::update(const std::vector<Iteration>& hist,
           "{:.3g} MPa, tensile {:.3g} MPa) and no earlier iteration did: the fit has nothing to "
           "step back to; start from other bond parameters (calibrate.starts, or the ore card's "
           "calibrated: section)",
-          hist.size(), last.ucs.r.youngs_modulus / 1e9, last.ucs.r.poisson_ratio,
-          last.ucs.r.ucs / 1e6, last.br.r.tensile_strength / 1e6));
+          hist.size(), lm.E / 1e9, lm.nu, lm.ucs / 1e6, lm.tensile / 1e6));
     const BondParams& g = good.back().p;
     BondParams p = g;
     // Halfway from the failed parameters towards the last usable ones: a
@@ -288,8 +322,7 @@ BondParams Fitting::update(const std::vector<Iteration>& hist,
     notes.push_back(fmt::format(
         "iteration {}: no usable response (E {:.3g} GPa, UCS {:.3g} MPa, tensile {:.3g} MPa): "
         "stepped back half way towards the parameters of the last usable iteration",
-        hist.size(), last.ucs.r.youngs_modulus / 1e9, last.ucs.r.ucs / 1e6,
-        last.br.r.tensile_strength / 1e6));
+        hist.size(), lm.E / 1e9, lm.ucs / 1e6, lm.tensile / 1e6));
     return p;
   }
   // The steps see the usable iterations only (their notes count those).
@@ -300,8 +333,8 @@ BondParams Fitting::update(const std::vector<Iteration>& hist,
 }
 
 bool Fitting::usable(const Iteration& it) {
-  const double E = it.ucs.r.youngs_modulus, nu = it.ucs.r.poisson_ratio, ucs = it.ucs.r.ucs,
-               t = it.br.r.tensile_strength;
+  const Measured m = it.measured();
+  const double E = m.E, nu = m.nu, ucs = m.ucs, t = m.tensile;
   const double k = it.scb ? it.scb->toughness : 1.0;
   return std::isfinite(E) && std::isfinite(nu) && std::isfinite(ucs) && std::isfinite(t) &&
          std::isfinite(k) && E > 0 && ucs > 0 && t > 0 && k > 0;
@@ -340,9 +373,9 @@ size_t Fitting::best_compromise(const std::vector<Iteration>& hist) const {
       const double e = w * std::log(achieved / target);
       return e * e;
     };
-    const double nu = (it.ucs.r.poisson_ratio - t_.nu) / kNuTolerance;
-    return sq(it.ucs.r.youngs_modulus, t_.E) + sq(it.ucs.r.ucs, t_.ucs) +
-           sq(it.br.r.tensile_strength, t_.tensile) +
+    const Measured m = it.measured();
+    const double nu = (m.nu - t_.nu) / kNuTolerance;
+    return sq(m.E, t_.E) + sq(m.ucs, t_.ucs) + sq(m.tensile, t_.tensile) +
            (it.scb ? sq(it.scb->toughness, t_.toughness) : 1e300) + nu * nu;
   };
   size_t best = 0;

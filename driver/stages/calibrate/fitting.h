@@ -40,13 +40,24 @@ inline constexpr double kUcsWeightOutOfReach = 0.05;
 // while the card's ratio is more than this factor above the one reached.
 inline constexpr double kCoarseLeverGap = 1.2;
 
-// One iteration: the bond parameters tried, both tests (and the
-// semi-circular bend test when the toughness is a target), their errors.
+// What the fit reads from an iteration: E, nu and the UCS of its UCS tests
+// and the tensile strength of its Brazilian tests, each the mean over the
+// fit's specimen packings (calibrate.fit_packings; with one, its own).
+struct Measured {
+  double E = 0, nu = 0, ucs = 0, tensile = 0;
+};
+
+// One iteration: the bond parameters tried, both tests on the first
+// packing and on the fit's further ones (and the semi-circular bend test
+// when the toughness is a target), their errors.
 struct Iteration {
   BondParams p;
-  UcsRun ucs;
+  UcsRun ucs;  // on the first packing (calibrate.seed's): its curves are the report's
   BrazilianRun br;
+  std::vector<PackingRun> more;  // on the fit's further packings (calibrate.fit_packings - 1)
   std::optional<ScbRun> scb;
+  // The responses the fit aims at the ore card: the means over all packings.
+  Measured measured() const;
   double err_E = 0, err_ucs = 0, err_t = 0, err_nu = 0;
   double err_kic = 0;  // relative error of K_IC (0 when not a target)
   bool converged = false;

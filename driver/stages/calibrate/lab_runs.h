@@ -51,6 +51,14 @@ struct BrazilianRun : LabRun {
   post::BrazilianResult r;
 };
 
+// The UCS and Brazilian tests of one set of bond parameters on one specimen
+// packing (a further packing of the fit, or of the packing check).
+struct PackingRun {
+  long seed = 0;  // the packing's first seed (Specimen::seed)
+  UcsRun ucs;
+  BrazilianRun br;
+};
+
 struct TriaxialRun : LabRun {
   double pressure = 0;  // Pa, the confining pressure asked
   post::TriaxialResult r;

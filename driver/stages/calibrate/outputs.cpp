@@ -20,15 +20,24 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The macro properties an iteration achieved, with the ore card's key names.
-// (K_IC when the iteration ran the bend test of the toughness fit.)
+// The macro properties an iteration achieved, with the ore card's key names:
+// the means over the fit's packings (K_IC when the iteration ran the bend
+// test of the toughness fit).
 nlohmann::json macro(const Iteration& it) {
-  nlohmann::json m{{"youngs_modulus", it.ucs.r.youngs_modulus},
-                   {"poisson_ratio", it.ucs.r.poisson_ratio},
-                   {"ucs", it.ucs.r.ucs},
-                   {"tensile_strength", it.br.r.tensile_strength}};
+  const Measured a = it.measured();
+  nlohmann::json m{{"youngs_modulus", a.E},
+                   {"poisson_ratio", a.nu},
+                   {"ucs", a.ucs},
+                   {"tensile_strength", a.tensile}};
   if (it.scb) m["fracture_toughness"] = it.scb->toughness;
   return m;
+}
+
+// Wall seconds of an iteration's tests, every packing's and the bend test's.
+double iteration_seconds(const Iteration& it) {
+  double s = it.ucs.seconds + it.br.seconds + (it.scb ? it.scb->seconds : 0.0);
+  for (const PackingRun& r : it.more) s += r.ucs.seconds + r.br.seconds;
+  return s;
 }
 
 // A value of a run's info line, 0 when the deck did not write it.
@@ -63,6 +72,7 @@ class Report {
         hist_(o.hist),
         best_(o.best),
         b_(o.hist[o.best]),
+        bm_(b_.measured()),
         half_(o.half),
         wall_(o.wall),
         notes_(o.notes),
@@ -96,6 +106,7 @@ class Report {
   const std::vector<Iteration>& hist_;
   const size_t best_;
   const Iteration& b_;
+  const Measured bm_;  // what the fit read of the result (means over its packings)
   const std::optional<UcsRun>& half_;
   const double wall_;
   const std::vector<std::string>& notes_;
@@ -114,14 +125,14 @@ std::vector<std::string> Report::explain_missed() const {
   std::vector<std::string> missed;
   if (b_.err_E > tol_)
     missed.push_back(fmt::format("E {:.2f} GPa is {:.0f}% off the target after {} iterations",
-                                 b_.ucs.r.youngs_modulus / 1e9, 100 * b_.err_E, hist_.size()));
+                                 bm_.E / 1e9, 100 * b_.err_E, hist_.size()));
   if (b_.err_nu > kNuTolerance)
     missed.push_back(
-        fmt::format("nu {:.3f} is {:.3f} off the target: kn/ks {:.2f} (kept in [0.5, 20])",
-                    b_.ucs.r.poisson_ratio, b_.err_nu, b_.p.stiffness_ratio));
+        fmt::format("nu {:.3f} is {:.3f} off the target: kn/ks {:.2f} (kept in [0.5, 20])", bm_.nu,
+                    b_.err_nu, b_.p.stiffness_ratio));
   if (b_.err_t > tol_)
     missed.push_back(fmt::format("tensile strength {:.2f} MPa is {:.0f}% off the target",
-                                 b_.br.r.tensile_strength / 1e6, 100 * b_.err_t));
+                                 bm_.tensile / 1e6, 100 * b_.err_t));
   if (t_.toughness > 0 && b_.err_kic > tol_) {
     // K_IC follows the bond tensile strength (the notch opens in tension);
     // the Brazilian strength follows it and the cohesion together, so K_IC
@@ -136,7 +147,7 @@ std::vector<std::string> Report::explain_missed() const {
         b_.p.tensile / 1e6, b_.p.cohesion / 1e6, sp_.mean_radius * 1e3, t_.toughness / t_.tensile));
   }
   if (b_.err_ucs > tol_) {
-    const double ratio = b_.ucs.r.ucs / b_.br.r.tensile_strength, want = t_.ucs / t_.tensile;
+    const double ratio = bm_.ucs / bm_.tensile, want = t_.ucs / t_.tensile;
     // Measured sensitivity of the UCS to the cohesion ratio (last two iterations that moved it).
     std::string lever;
     for (size_t i = hist_.size(); i-- > 1;) {
@@ -145,8 +156,8 @@ std::vector<std::string> Report::explain_missed() const {
       if (std::abs(std::log(r2 / r1)) < 1e-3) continue;
       lever = fmt::format(
           "; raising cohesion/tensile from {:.2f} to {:.2f} changed the UCS by {:+.1f}%{}", r1, r2,
-          100 * (hist_[i].ucs.r.ucs / hist_[i - 1].ucs.r.ucs - 1),
-          std::abs(hist_[i].ucs.r.ucs / hist_[i - 1].ucs.r.ucs - 1) < 0.05
+          100 * (hist_[i].measured().ucs / hist_[i - 1].measured().ucs - 1),
+          std::abs(hist_[i].measured().ucs / hist_[i - 1].measured().ucs - 1) < 0.05
               ? ": the bonds fail in tension (bending included), so the shear strength cannot "
                 "raise the UCS"
               : "");
@@ -154,7 +165,7 @@ std::vector<std::string> Report::explain_missed() const {
     }
     double best_ratio = 0.0;
     for (const auto& it : hist_)
-      best_ratio = std::max(best_ratio, it.ucs.r.ucs / it.br.r.tensile_strength);
+      best_ratio = std::max(best_ratio, it.measured().ucs / it.measured().tensile);
     // Where the UCS/tensile levers stand, by model; the same head and tail.
     const double c_ratio = b_.p.cohesion / b_.p.tensile;
     const char* cap = c_ratio >= kMaxCohesionRatio * 0.999 ? ", at its cap" : "";
@@ -178,11 +189,11 @@ std::vector<std::string> Report::explain_missed() const {
             ? fmt::format("UCS {:.1f} MPa is {:.0f}% off the target: UCS/tensile reached {:.1f} "
                           "against {:.1f} on the card (at most {:.1f} over the {} iterations). "
                           "{}{}",
-                          b_.ucs.r.ucs / 1e6, 100 * b_.err_ucs, ratio, want, best_ratio,
-                          hist_.size(), levers, lever)
+                          bm_.ucs / 1e6, 100 * b_.err_ucs, ratio, want, best_ratio, hist_.size(),
+                          levers, lever)
             : fmt::format("UCS {:.1f} MPa is {:.0f}% off the target (UCS/tensile "
                           "{:.1f} is right: the strength level needs more iterations)",
-                          b_.ucs.r.ucs / 1e6, 100 * b_.err_ucs, ratio));
+                          bm_.ucs / 1e6, 100 * b_.err_ucs, ratio));
   }
   return missed;
 }
@@ -211,8 +222,13 @@ nlohmann::json Report::json() const {
          {"brazilian_peaked", it.br.peaked},
          {"energy",
           {{"ucs", lab_energy_json(it.ucs.energy)}, {"brazilian", lab_energy_json(it.br.energy)}}},
-         {"wall_seconds", it.ucs.seconds + it.br.seconds}});
+         {"wall_seconds", iteration_seconds(it)}});
     if (t_.toughness > 0) iters.back()["errors"]["fracture_toughness"] = it.err_kic;
+    if (!it.more.empty()) {  // the fit's packings, each (calibrate.fit_packings)
+      nlohmann::json each = nlohmann::json::array({packing_run_json(sp_.seed, it.ucs, it.br)});
+      for (const PackingRun& r : it.more) each.push_back(packing_run_json(r.seed, r.ucs, r.br));
+      iters.back()["packings"] = each;
+    }
     if (it.scb) {  // the bend test of the toughness fit
       nlohmann::json& j = iters.back();
       j["scb_peak_force_N"] = it.scb->peak_force;
@@ -313,9 +329,9 @@ std::string Report::yaml() const {
   if (t_.toughness > 0) y << YAML::Key << "fracture_toughness" << YAML::Value << t_.toughness;
   y << YAML::EndMap;
   y << YAML::Key << "achieved" << YAML::Value << YAML::BeginMap;
-  y << YAML::Key << "youngs_modulus" << YAML::Value << b_.ucs.r.youngs_modulus << YAML::Key
-    << "poisson_ratio" << YAML::Value << b_.ucs.r.poisson_ratio << YAML::Key << "ucs" << YAML::Value
-    << b_.ucs.r.ucs << YAML::Key << "tensile_strength" << YAML::Value << b_.br.r.tensile_strength;
+  y << YAML::Key << "youngs_modulus" << YAML::Value << bm_.E << YAML::Key << "poisson_ratio"
+    << YAML::Value << bm_.nu << YAML::Key << "ucs" << YAML::Value << bm_.ucs << YAML::Key
+    << "tensile_strength" << YAML::Value << bm_.tensile;
   if (b_.scb) y << YAML::Key << "fracture_toughness" << YAML::Value << b_.scb->toughness;
   y << YAML::EndMap;
   y << YAML::Key << "specimen" << YAML::Value << YAML::BeginMap;
@@ -341,16 +357,13 @@ std::string Report::markdown() const {
                     hist_.size(), best_ + 1, Progress::duration(wall_));
   md << "| property | target | achieved | error | tolerance | ok |\n|---|---|---|---|---|---|\n";
   md << fmt::format("| E (GPa) | {:.2f} | {:.2f} | {:.1f}% | {:.0f}% | {} |\n", t_.E / 1e9,
-                    b_.ucs.r.youngs_modulus / 1e9, 100 * b_.err_E, 100 * tol_,
-                    b_.err_E <= tol_ ? "yes" : "no");
-  md << fmt::format("| nu | {:.3f} | {:.3f} | {:.3f} | {:.2f} | {} |\n", t_.nu,
-                    b_.ucs.r.poisson_ratio, b_.err_nu, kNuTolerance,
-                    b_.err_nu <= kNuTolerance ? "yes" : "no");
+                    bm_.E / 1e9, 100 * b_.err_E, 100 * tol_, b_.err_E <= tol_ ? "yes" : "no");
+  md << fmt::format("| nu | {:.3f} | {:.3f} | {:.3f} | {:.2f} | {} |\n", t_.nu, bm_.nu, b_.err_nu,
+                    kNuTolerance, b_.err_nu <= kNuTolerance ? "yes" : "no");
   md << fmt::format("| UCS (MPa) | {:.1f} | {:.1f} | {:.1f}% | {:.0f}% | {} |\n", t_.ucs / 1e6,
-                    b_.ucs.r.ucs / 1e6, 100 * b_.err_ucs, 100 * tol_,
-                    b_.err_ucs <= tol_ ? "yes" : "no");
+                    bm_.ucs / 1e6, 100 * b_.err_ucs, 100 * tol_, b_.err_ucs <= tol_ ? "yes" : "no");
   md << fmt::format("| tensile (MPa) | {:.2f} | {:.2f} | {:.1f}% | {:.0f}% | {} |\n",
-                    t_.tensile / 1e6, b_.br.r.tensile_strength / 1e6, 100 * b_.err_t, 100 * tol_,
+                    t_.tensile / 1e6, bm_.tensile / 1e6, 100 * b_.err_t, 100 * tol_,
                     b_.err_t <= tol_ ? "yes" : "no");
   if (t_.toughness > 0 && b_.scb)
     md << fmt::format(
@@ -373,24 +386,31 @@ std::string Report::markdown() const {
       b_.p.radius_multiplier);
   // The toughness fit adds a K_IC column.
   const bool kic = t_.toughness > 0;
+  md << "## Iterations\n\n";
+  if (!b_.more.empty())
+    md << fmt::format(
+        "E, nu, UCS and tensile: the means over the fit's {} specimen packings "
+        "(calibrate.fit_packings), what the fit aims at the card; each packing's in report.json "
+        "(iterations[].packings).\n\n",
+        b_.more.size() + 1);
   md << fmt::format(
-      "## Iterations\n\n| it | E_b (GPa) | kn/ks | sigma_b (MPa) | c (MPa) | phi (deg) | beta | "
+      "| it | E_b (GPa) | kn/ks | sigma_b (MPa) | c (MPa) | phi (deg) | beta | "
       "E (GPa) | nu | UCS (MPa) | tensile (MPa) | UCS/tensile | {}"
       "wall (s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|{}---|\n",
       kic ? "K_IC (MPa m^0.5) | " : "", kic ? "---|" : "");
   for (size_t i = 0; i < hist_.size(); ++i) {
     const auto& it = hist_[i];
+    const Measured m = it.measured();
     md << fmt::format(
         "| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.0f} | {:g} | {:.2f} | {:.3f} | {:.2f} | "
         "{:.2f} | {:.2f} | {}{:.0f} |\n",
         i + 1, it.p.modulus / 1e9, it.p.stiffness_ratio, it.p.tensile / 1e6, it.p.cohesion / 1e6,
-        it.p.friction_angle_deg, it.p.moment_factor, it.ucs.r.youngs_modulus / 1e9,
-        it.ucs.r.poisson_ratio, it.ucs.r.ucs / 1e6, it.br.r.tensile_strength / 1e6,
-        it.ucs.r.ucs / it.br.r.tensile_strength,
+        it.p.friction_angle_deg, it.p.moment_factor, m.E / 1e9, m.nu, m.ucs / 1e6, m.tensile / 1e6,
+        m.ucs / m.tensile,
         !kic     ? std::string()
         : it.scb ? fmt::format("{:.3f} | ", it.scb->toughness / 1e6)
                  : std::string("- | "),
-        it.ucs.seconds + it.br.seconds + (it.scb ? it.scb->seconds : 0.0));
+        iteration_seconds(it));
   }
   if (half_)
     md << fmt::format(
@@ -464,8 +484,8 @@ std::string Report::summary() const {
   return fmt::format(
       "[calibrate] {}: E {:.2f} GPa, nu {:.3f}, UCS {:.1f} MPa, tensile {:.2f} MPa "
       "(iteration {}){}{}",
-      b_.converged ? "converged" : "NOT all targets reached", b_.ucs.r.youngs_modulus / 1e9,
-      b_.ucs.r.poisson_ratio, b_.ucs.r.ucs / 1e6, b_.br.r.tensile_strength / 1e6, best_ + 1,
+      b_.converged ? "converged" : "NOT all targets reached", bm_.E / 1e9, bm_.nu, bm_.ucs / 1e6,
+      bm_.tensile / 1e6, best_ + 1,
       half_ ? fmt::format("; rate check: UCS changes {:.1f}% at half the rate", 100 * rate_change_)
             : "",
       o_.checks.mc ? fmt::format("; envelope (a check, not fitted): friction angle {:.1f} deg, "

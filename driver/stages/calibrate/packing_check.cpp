@@ -55,13 +55,13 @@ std::string limit_text(const Row& r) {
 }  // namespace
 
 std::vector<PackingRun> run_packings(StageContext& ctx, const std::string& job_label,
-                                     const std::filesystem::path& dir, long n, int packings,
-                                     const BondParams& p, const Targets& t, double rate, int lanes,
-                                     double done, double step_share) {
+                                     const std::filesystem::path& dir, long n, int first,
+                                     int packings, const BondParams& p, const Targets& t,
+                                     double rate, int lanes, double done, double step_share) {
   std::vector<PackingRun> runs;
   for (int k = 1; k <= packings; ++k) {
     PackingRun r;
-    const Specimen sp = pack_specimen(ctx, job_label, dir, n, k);
+    const Specimen sp = pack_specimen(ctx, job_label, dir, n, first + k - 1);
     r.seed = sp.seed;
     LabBench lab(ctx, job_label, dir, sp, t);
     lab.set_lanes(lanes);
@@ -87,12 +87,16 @@ std::vector<PackingRun> run_packings(StageContext& ctx, const std::string& job_l
 
 PackingSpread packing_spread(const Iteration& best, long seed, const std::vector<PackingRun>& runs,
                              double tol, double nu_tol) {
-  if (runs.empty()) throw std::invalid_argument("packing check: no further packing ran");
+  if (runs.empty() && best.more.empty())
+    throw std::invalid_argument("packing check: one packing only, nothing to compare");
   PackingSpread s;
   s.seeds.push_back(seed);
+  s.fit_packings = 1 + best.more.size();
   std::vector<double> e{best.ucs.r.youngs_modulus}, nu{best.ucs.r.poisson_ratio},
       ucs{best.ucs.r.ucs}, t{best.br.r.tensile_strength};
-  for (const PackingRun& r : runs) {
+  std::vector<PackingRun> all = best.more;
+  all.insert(all.end(), runs.begin(), runs.end());
+  for (const PackingRun& r : all) {
     s.seeds.push_back(r.seed);
     e.push_back(r.ucs.r.youngs_modulus);
     nu.push_back(r.ucs.r.poisson_ratio);
@@ -106,8 +110,21 @@ PackingSpread packing_spread(const Iteration& best, long seed, const std::vector
   return s;
 }
 
+nlohmann::json packing_run_json(long seed, const UcsRun& ucs, const BrazilianRun& br) {
+  return {{"seed", seed},
+          {"youngs_modulus", ucs.r.youngs_modulus},
+          {"poisson_ratio", ucs.r.poisson_ratio},
+          {"ucs", ucs.r.ucs},
+          {"tensile_strength", br.r.tensile_strength},
+          {"ucs_run", ucs.tag},
+          {"brazilian_run", br.tag},
+          {"energy",
+           {{"ucs", lab_energy_json(ucs.energy)}, {"brazilian", lab_energy_json(br.energy)}}}};
+}
+
 nlohmann::json packing_json(const PackingSpread& s, const std::vector<PackingRun>& runs) {
-  nlohmann::json j = {{"seeds", s.seeds}, {"within_tolerance", s.within()}};
+  nlohmann::json j = {
+      {"seeds", s.seeds}, {"fit_packings", s.fit_packings}, {"within_tolerance", s.within()}};
   for (const Row& r : rows(s))
     j[r.json] = {{"values", r.p->values},       {"mean", r.p->mean},
                  {"spread", r.p->spread},       {"spread_is_absolute", r.absolute},
@@ -116,12 +133,7 @@ nlohmann::json packing_json(const PackingSpread& s, const std::vector<PackingRun
   nlohmann::json each = nlohmann::json::array();
   for (const PackingRun& r : runs) {
     seconds += r.ucs.seconds + r.br.seconds;
-    each.push_back({{"seed", r.seed},
-                    {"ucs_run", r.ucs.tag},
-                    {"brazilian_run", r.br.tag},
-                    {"energy",
-                     {{"ucs", lab_energy_json(r.ucs.energy)},
-                      {"brazilian", lab_energy_json(r.br.energy)}}}});
+    each.push_back(packing_run_json(r.seed, r.ucs, r.br));
   }
   j["wall_seconds"] = seconds;
   j["runs"] = each;
@@ -130,15 +142,21 @@ nlohmann::json packing_json(const PackingSpread& s, const std::vector<PackingRun
 
 std::string packing_markdown(const PackingSpread& s) {
   std::string md = "\n## Packing check\n\n";
+  const size_t further = s.seeds.size() - s.fit_packings;
   md += fmt::format(
-      "The result's bond parameters on {} further specimen packings (calibrate.packing_check), "
+      "The result's bond parameters on {} further specimen packings (calibrate.packing_check){}, "
       "each carved from its own ball and named by the first seed of its packing (the fit's "
-      "follows calibrate.seed): the spread is the range over the {} packings (relative to their "
-      "mean; nu absolute), against the fit's tolerance.\n\n",
-      s.seeds.size() - 1, s.seeds.size());
+      "first follows calibrate.seed): the spread is the range over the {} packings (relative to "
+      "their mean; nu absolute), against the fit's tolerance.\n\n",
+      further,
+      s.fit_packings > 1 ? fmt::format(" and the fit's own {} (calibrate.fit_packings: it aims "
+                                       "their means at the card)",
+                                       s.fit_packings)
+                         : std::string(),
+      s.seeds.size());
   md += "| property | ";
   for (size_t k = 0; k < s.seeds.size(); ++k)
-    md += fmt::format("seed {}{} | ", s.seeds[k], k == 0 ? " (fit)" : "");
+    md += fmt::format("seed {}{} | ", s.seeds[k], k < s.fit_packings ? " (fit)" : "");
   md += "mean | spread | tolerance | within |\n|---|";
   for (size_t k = 0; k < s.seeds.size() + 4; ++k) md += "---|";
   md += "\n";
@@ -151,11 +169,16 @@ std::string packing_markdown(const PackingSpread& s) {
   md += fmt::format("\nUCS / tensile: ");
   for (size_t k = 0; k < s.seeds.size(); ++k)
     md += fmt::format("{}{:.2f}", k ? ", " : "", s.ucs.values[k] / s.tensile.values[k]);
-  md += s.within()
-            ? ".\n\nWithin the tolerance: the fit describes the bonds, not one packing.\n"
-            : ".\n\n**Beyond the tolerance**: what the fit met on its packing, another packing of "
-              "the same size does not; raise calibrate.n_elements (larger specimens average more "
-              "contacts) before reading the result as the ore's.\n";
+  md += s.within() ? ".\n\nWithin the tolerance: the fit describes the bonds, not one packing.\n"
+        : s.fit_packings > 1
+            ? ".\n\n**Beyond the tolerance** from packing to packing: the fit met the card on "
+              "the mean of its packings, but one specimen of this size (and one lump) can be "
+              "that far from it; raise calibrate.n_elements (larger specimens average more "
+              "contacts) to narrow it.\n"
+            : ".\n\n**Beyond the tolerance**: what the fit met on its packing, another "
+              "packing of the same size does not; raise calibrate.n_elements (larger "
+              "specimens average more contacts), or fit the mean of several packings "
+              "(calibrate.fit_packings), before reading the result as the ore's.\n";
   return md;
 }
 
@@ -168,9 +191,10 @@ std::string packing_warning(const PackingSpread& s, long n_elements) {
                           spread_text(r), limit_text(r));
   return fmt::format(
       "packing check: over {} packings of {} elements the result spreads beyond the "
-      "fit's tolerance in {}: the specimens are too small for it; raise calibrate.n_elements "
+      "fit's tolerance in {}: the specimens are too small for it; raise calibrate.n_elements{} "
       "(report.md, \"Packing check\")",
-      s.seeds.size(), n_elements, what);
+      s.seeds.size(), n_elements, what,
+      s.fit_packings > 1 ? "" : ", or fit the mean of several packings (calibrate.fit_packings)");
 }
 
 }  // namespace mill::calibrate

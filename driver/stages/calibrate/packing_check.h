@@ -20,21 +20,15 @@
 
 namespace mill::calibrate {
 
-// The result's two tests on one further packing.
-struct PackingRun {
-  long seed = 0;  // the packing's first seed (Specimen::seed)
-  UcsRun ucs;
-  BrazilianRun br;
-};
-
 // The result's parameters p on `packings` further packings of n-element
-// specimens (pack_specimen's packings 1, 2, ...), each its own ball, with
-// targets t at strain rate `rate`: a UCS and a Brazilian test each, side by
-// side on `lanes` lanes; progress from `done`, `step_share` per test.
+// specimens (pack_specimen's packings first, first + 1, ...: after the
+// fit's own), each its own ball, with targets t at strain rate `rate`: a UCS
+// and a Brazilian test each, side by side on `lanes` lanes; progress from
+// `done`, `step_share` per test.
 std::vector<PackingRun> run_packings(StageContext& ctx, const std::string& job_label,
-                                     const std::filesystem::path& dir, long n, int packings,
-                                     const BondParams& p, const Targets& t, double rate, int lanes,
-                                     double done, double step_share);
+                                     const std::filesystem::path& dir, long n, int first,
+                                     int packings, const BondParams& p, const Targets& t,
+                                     double rate, int lanes, double done, double step_share);
 
 // One property over the packings, the fit's own first.
 struct PackingProperty {
@@ -47,17 +41,23 @@ struct PackingProperty {
 };
 
 struct PackingSpread {
-  std::vector<long> seeds;  // the fit's seed first
+  std::vector<long> seeds;  // the fit's seeds first
+  size_t fit_packings = 1;  // how many of them the fit averaged (calibrate.fit_packings)
   PackingProperty E, nu, ucs, tensile;
   // Every property within the fit's tolerance from packing to packing.
   bool within() const { return E.within() && nu.within() && ucs.within() && tensile.within(); }
 };
 
-// The spread of the result `best` (fitted on the packing of `seed`) and its
-// runs on further packings; `tol` the fit's relative tolerance, `nu_tol`
-// its absolute one for nu. Throws std::invalid_argument without runs.
+// The spread of the result `best` over its own packings (the first of
+// `seed`, then best.more) and its runs on further packings; `tol` the fit's
+// relative tolerance, `nu_tol` its absolute one for nu. Throws
+// std::invalid_argument with one packing in all.
 PackingSpread packing_spread(const Iteration& best, long seed, const std::vector<PackingRun>& runs,
                              double tol, double nu_tol);
+
+// One packing's runs in report.json: its seed, E, nu, UCS and tensile
+// strength, the runs' folders and energy ledgers.
+nlohmann::json packing_run_json(long seed, const UcsRun& ucs, const BrazilianRun& br);
 
 // report.json's "packing_check": the spread, and each further packing's runs
 // with their energy ledgers.
