@@ -78,6 +78,13 @@ bool card_has_stale_calibration(const config::CaseConfig& cfg) {
   return card_calibration_fits_model(cfg) && !card_is_calibrated(cfg);
 }
 
+// Wall seconds of an iteration's tests on the fit's further packings.
+double more_seconds(const Iteration& it) {
+  double s = 0;
+  for (const PackingRun& r : it.more) s += r.ucs.seconds + r.br.seconds;
+  return s;
+}
+
 // Everything one calibration run needs, gathered from the case.
 class Calibration {
  public:
@@ -234,7 +241,8 @@ void Calibration::run() {
         more.empty() ? "" : fmt::format(" (means over {} packings)", fit_packings_),
         it.scb ? fmt::format(", K_IC {} ({:.3f})", it.scb->summary(), t.toughness / 1e6) : "",
         it.converged ? ": all within tolerance" : "", it.ucs.seconds, it.br.seconds,
-        it.scb ? fmt::format(" + {:.0f} s", it.scb->seconds) : ""));
+        it.scb ? fmt::format(" + {:.0f} s", it.scb->seconds) : "",
+        more.empty() ? "" : fmt::format(" + {:.0f} s on the other packings", more_seconds(it))));
     if (it.scb && !it.scb->peaked)
       notes.push_back(fmt::format(
           "iteration {}: the semi-circular bend test reached its cap still loading", k));

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "calibrate_test_iterations.h"
 #include "stages/calibrate/fitting.h"
 #include "stages/calibrate/packing_check.h"
 
@@ -16,24 +17,11 @@ using mill::calibrate::PackingRun;
 
 // A result with E, nu, UCS and T on the fit's packing.
 Iteration result(double E, double nu, double ucs, double t) {
-  Iteration it;
-  it.ucs.r.youngs_modulus = E;
-  it.ucs.r.poisson_ratio = nu;
-  it.ucs.r.ucs = ucs;
-  it.br.r.tensile_strength = t;
-  return it;
+  return mill::test::iteration({}, E, nu, ucs, t);
 }
 
 PackingRun run(long seed, double E, double nu, double ucs, double t) {
-  PackingRun r;
-  r.seed = seed;
-  r.ucs.r.youngs_modulus = E;
-  r.ucs.r.poisson_ratio = nu;
-  r.ucs.r.ucs = ucs;
-  r.br.r.tensile_strength = t;
-  r.ucs.tag = "packing_ucs";
-  r.br.tag = "packing_brazilian";
-  return r;
+  return mill::test::packing_run(seed, E, nu, ucs, t);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "calibrate_test_iterations.h"
 #include "stages/calibrate/fitting.h"
 
 using namespace mill;
@@ -19,13 +20,7 @@ const Targets kCard{18.69e9, 0.18, 50e6, 5e6};  // sandstone
 
 // An iteration with parameters p that achieved E, nu, UCS and T.
 Iteration made(const BondParams& p, double E, double nu, double ucs, double t) {
-  Iteration it;
-  it.p = p;
-  it.ucs.r.youngs_modulus = E;
-  it.ucs.r.poisson_ratio = nu;
-  it.ucs.r.ucs = ucs;
-  it.br.r.tensile_strength = t;
-  return it;
+  return mill::test::iteration(p, E, nu, ucs, t);
 }
 
 BondParams start() {
