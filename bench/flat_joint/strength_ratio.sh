@@ -80,6 +80,7 @@ run_test() {
       -var bond_style "$( [ "$4" = flatjoint ] && echo flatjoint || echo breakable )" \
       -var bond_model_keys "$(model_keys "$4")" -var radius_mult "$radius_mult" \
       -var bond_gap "$bond_gap" -var max_bonds "$max_bonds" -var unbonded_frac "$unbonded_frac" \
+      -var deck_dir "$root/liggghts_inputs" \
       $( [ "$1" = scb ] && echo "-var carve_angle $scb_angle" )) ||
     { echo "strength_ratio: $4 $1 failed: see $dir/liggghts.log" >&2; exit 1; }
 }

@@ -83,7 +83,8 @@ fs::path LabBench::run_test(const Test& test, const BondParams& p, double rate, 
            {"sample_time", num(test.peak_strain / rate / 300.0)},
            {"skin", num(0.3 * sp_.mean_radius)},
            {"bond_gap", num(d.real("lump.bond_gap"))},
-           {"max_bonds", std::to_string(d.integer("lump.max_bonds"))}})
+           {"max_bonds", std::to_string(d.integer("lump.max_bonds"))},
+           {"deck_dir", fs::absolute(ctx_.cfg.project_dir / "liggghts_inputs").string()}})
     vars.push_back(kv);
   vars.insert(vars.end(), test.extra.begin(), test.extra.end());
   const fs::path work = dir_ / "runs" / step.tag;
