@@ -469,12 +469,18 @@ void packing_row(const json& pc, const RowAdder& add) {
                           g3(hi * p.scale), p.unit);
   }
   const std::string tol_text = tol.empty() ? "the fit's tolerance" : "the " + tol + " tolerance";
+  // A fit on the mean of several packings (calibrate.fit_packings) says so.
+  const json fitted = pick(pc, "fit_packings");
+  const std::string of =
+      num(fitted) && d(fitted) > 1
+          ? fmt::format("{} packings (the fit read the mean of {})", n, d(fitted))
+          : fmt::format("{} packings", n);
   if (ranges.empty())
-    add(2, "calibration over specimen packings",
-        fmt::format("within {} over {} packings", tol_text, n), false);
+    add(2, "calibration over specimen packings", fmt::format("within {} over {}", tol_text, of),
+        false);
   else
     add(2, "calibration over specimen packings",
-        fmt::format("{} over {} packings: beyond {}, the specimens are too small for it", ranges, n,
+        fmt::format("{} over {}: beyond {}, the specimens are too small for it", ranges, of,
                     tol_text));
 }
 
