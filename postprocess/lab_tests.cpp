@@ -81,6 +81,7 @@ StressStrain ToStressStrain(const LoadCurve& c, double gauge_length_m, double ar
     s.stress.push_back(c.force(i) / area_m2);
     s.lateral_strain.push_back(c.lateral_strain[i]);
   }
+  s.broken_bonds = c.broken_bonds;
   return s;
 }
 
@@ -119,7 +120,24 @@ size_t argmax(const std::vector<double>& v) {
 UcsResult AnalyseUcs(const StressStrain& s, double lo_frac, double hi_frac) {
   if (s.stress.empty()) throw std::runtime_error("UCS test: empty stress-strain curve");
   UcsResult r;
-  r.peak_index = argmax(s.stress);
+  // Failure: the stress below kUcsFailureFraction of its running maximum,
+  // bonds broken since that maximum.
+  r.failure_index = s.stress.size();
+  if (s.broken_bonds.size() == s.stress.size()) {
+    size_t top = 0;
+    for (size_t i = 1; i < s.stress.size(); ++i) {
+      if (s.stress[i] > s.stress[top]) {
+        top = i;
+      } else if (s.stress[i] < kUcsFailureFraction * s.stress[top] &&
+                 s.broken_bonds[i] > s.broken_bonds[top]) {
+        r.failure_index = i;
+        break;
+      }
+    }
+  }
+  r.peak_index = static_cast<size_t>(
+      std::max_element(s.stress.begin(), s.stress.begin() + static_cast<long>(r.failure_index)) -
+      s.stress.begin());
   r.ucs = s.stress[r.peak_index];
   r.strain_at_peak = s.strain[r.peak_index];
   if (!(r.ucs > 0))

@@ -44,8 +44,10 @@ using namespace calibrate;
 // radius, bonding range) and its fitted_for names it: a section written
 // before would no longer be read. 8: the lab decks' step is also at most
 // the bonds' critical step with their dashpots (fix bond/breakable f_ID[8]):
-// smaller at high coordination, where the old one created energy.
-constexpr int kDeckVersion = 8;
+// smaller at high coordination, where the old one created energy. 9: the
+// UCS is the peak before the specimen fails (post::kUcsFailureFraction), not
+// a later one of its debris compacted between the platens.
+constexpr int kDeckVersion = 9;
 
 // The fit's targets: the card's four macro properties, and its K_IC when
 // the fit aims at it.

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -72,6 +73,52 @@ TEST(LabTests, YoungsModulusPoissonRatioAndPeakOfAHandMadeCurve) {
   EXPECT_NEAR(r.strain_at_peak, eps_p, 1.5 * eps_p / 400);
   EXPECT_GT(r.fit.r2, 0.999999);
   EXPECT_NEAR(r.fit_stress_lo, 0.2 * r.ucs, 1e-6 * r.ucs);
+}
+
+// A specimen that fails and whose debris then carries more (the default
+// case's parallel bond at a 60 deg bond friction angle, bench/README.md,
+// "The UCS before the debris"): linear to 24 MPa at E = 20 GPa with nu 0.2,
+// bonds breaking at the peak, a drop to 15 MPa (0.625 x), then a rise to
+// 32 MPa. The UCS is the first peak, E and nu those of its loading branch;
+// the same curve with no bond broken at the drop (a start-up dip), or a dip
+// to 0.75 x only, keeps the whole curve's maximum.
+TEST(LabTests, UcsIsThePeakBeforeTheSpecimenFails) {
+  const double E = 20e9, nu = 0.2;
+  StressStrain s;
+  auto add = [&](double eps, double sigma, double lat, double broken) {
+    s.strain.push_back(eps);
+    s.stress.push_back(sigma);
+    s.lateral_strain.push_back(lat);
+    s.broken_bonds.push_back(broken);
+  };
+  for (int i = 0; i <= 120; ++i) {  // loading: 0 .. 24 MPa
+    const double eps = 1.2e-3 * i / 120;
+    add(eps, E * eps, nu * eps, 0);
+  }
+  add(1.25e-3, 15e6, 3e-3, 400);  // failure: bonds break, the load falls
+  for (int i = 1; i <= 100; ++i)  // the debris compacted: up to 32 MPa
+    add(1.25e-3 + 5e-5 * i, 15e6 + 0.17e6 * i, 3e-3 + 1e-3 * i, 400 + i);
+  const UcsResult r = AnalyseUcs(s);
+  EXPECT_EQ(r.failure_index, 121u);
+  EXPECT_EQ(r.peak_index, 120u);
+  EXPECT_NEAR(r.ucs, 24e6, 1e-3);
+  EXPECT_NEAR(r.youngs_modulus / E, 1.0, 1e-9);
+  EXPECT_NEAR(r.poisson_ratio, nu, 1e-9);
+  // No bond broken at the drop: not a failure, the maximum of the curve.
+  StressStrain dip = s;
+  std::fill(dip.broken_bonds.begin(), dip.broken_bonds.end(), 0.0);
+  const UcsResult d = AnalyseUcs(dip);
+  EXPECT_EQ(d.failure_index, dip.stress.size());
+  EXPECT_NEAR(d.ucs, 32e6, 1e-3);
+  // A drop to 0.75 x: above kUcsFailureFraction, not a failure either.
+  StressStrain shallow = s;
+  for (size_t i = 121; i < shallow.stress.size(); ++i)
+    shallow.stress[i] = std::max(shallow.stress[i], 0.75 * 24e6);
+  EXPECT_NEAR(AnalyseUcs(shallow).ucs, 32e6, 1e-3);
+  // Without broken-bond counts (a curve made by hand): the whole curve.
+  StressStrain bare = s;
+  bare.broken_bonds.clear();
+  EXPECT_NEAR(AnalyseUcs(bare).ucs, 32e6, 1e-3);
 }
 
 TEST(LabTests, UcsWithoutLoadOrWithTooFewSamplesIsAnError) {
