@@ -395,24 +395,26 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
   }
   // The tests of each iteration (the toughness fit adds the bend test).
   const long fit_packings = ctx.cfg.doc.integer("calibrate.fit_packings");
-  const std::string tests =
-      std::string(fits_toughness(ctx.cfg) ? "UCS + Brazilian + semi-circular bend tests (K_IC a "
-                                            "target)"
-                                          : "UCS + Brazilian tests") +
-      (fit_packings > 1 ? fmt::format(" on {} packings (their means fitted)", fit_packings)
-                        : std::string());
+  const char* tests = fits_toughness(ctx.cfg)
+                          ? "UCS + Brazilian + semi-circular bend tests (K_IC a "
+                            "target)"
+                          : "UCS + Brazilian tests";
+  // "400 elements" or "400 elements x 3 packings (their means fitted)".
+  const std::string specimens = fmt::format(
+      "{} elements{}", ctx.cfg.doc.integer("calibrate.n_elements"),
+      fit_packings > 1 ? fmt::format(" x {} packings (their means fitted)", fit_packings)
+                       : std::string());
   p.jobs.push_back(
       {"calibration", in,
        from_card
            ? fmt::format("copy calibrated.* from the ore card of {}", ctx.cfg.ore.str("name"))
-           : fmt::format("{} on {} elements, fit to {}; then {}{} triaxial{} "
-                         "check(s)",
-                         tests, ctx.cfg.doc.integer("calibrate.n_elements"), ctx.cfg.ore.str("name"),
-                         ctx.cfg.doc.boolean("calibrate.sensitivity")
-                             ? "the levers' sensitivities, "
-                             : "",
-                         ctx.cfg.doc.reals("calibrate.confining_pressures").size(),
-                         ctx.cfg.ore.has("fracture_toughness") ? " + semi-circular bend" : "")});
+           : fmt::format(
+                 "{} on {}, fit to {}; then {}{} triaxial{} "
+                 "check(s)",
+                 tests, specimens, ctx.cfg.ore.str("name"),
+                 ctx.cfg.doc.boolean("calibrate.sensitivity") ? "the levers' sensitivities, " : "",
+                 ctx.cfg.doc.reals("calibrate.confining_pressures").size(),
+                 ctx.cfg.ore.has("fracture_toughness") ? " + semi-circular bend" : "")});
   // Further starts: the fit alone from the estimate scaled (calibrate/starts.h).
   const int starts = static_cast<int>(ctx.cfg.doc.integer("calibrate.starts"));
   const BondParams estimate = estimate_bond_params(ctx.cfg.ore, ctx.cfg.doc);
@@ -425,10 +427,9 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
     const auto f = start_factors(k);
     p.jobs.push_back(
         {start_label(k), ink,
-         fmt::format("{} on {} elements, fit to {} from start {} (the estimate "
+         fmt::format("{} on {}, fit to {} from start {} (the estimate "
                      "x {:.3g}, {:.3g}, {:.3g}, {:.3g})",
-                     tests, ctx.cfg.doc.integer("calibrate.n_elements"), ctx.cfg.ore.str("name"),
-                     k, f[0], f[1], f[2], f[3])});
+                     tests, specimens, ctx.cfg.ore.str("name"), k, f[0], f[1], f[2], f[3])});
   }
   return p;
 }

@@ -145,7 +145,7 @@ TEST(CalibratePacking, SpreadOfAFitOnSeveralPackings) {
   EXPECT_NE(md.find("1 further specimen packings (calibrate.packing_check) and the fit's own 3"),
             std::string::npos)
       << md;
-  EXPECT_NE(md.find("the fit met the card on the mean of its packings"), std::string::npos) << md;
+  EXPECT_NE(md.find("the fit aims the mean of its packings at the card"), std::string::npos) << md;
   const std::string w = mill::calibrate::packing_warning(s, 400);
   EXPECT_NE(w.find("4 packings of 400 elements"), std::string::npos) << w;
   EXPECT_EQ(w.find("calibrate.fit_packings"), std::string::npos) << w;

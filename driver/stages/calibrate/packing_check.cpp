@@ -171,8 +171,8 @@ std::string packing_markdown(const PackingSpread& s) {
     md += fmt::format("{}{:.2f}", k ? ", " : "", s.ucs.values[k] / s.tensile.values[k]);
   md += s.within() ? ".\n\nWithin the tolerance: the fit describes the bonds, not one packing.\n"
         : s.fit_packings > 1
-            ? ".\n\n**Beyond the tolerance** from packing to packing: the fit met the card on "
-              "the mean of its packings, but one specimen of this size (and one lump) can be "
+            ? ".\n\n**Beyond the tolerance** from packing to packing: the fit aims the mean of "
+              "its packings at the card, but one specimen of this size (and one lump) can be "
               "that far from it; raise calibrate.n_elements (larger specimens average more "
               "contacts) to narrow it.\n"
             : ".\n\n**Beyond the tolerance**: what the fit met on its packing, another "
