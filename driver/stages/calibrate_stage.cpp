@@ -80,13 +80,6 @@ bool card_has_stale_calibration(const config::CaseConfig& cfg) {
   return card_calibration_fits_model(cfg) && !card_is_calibrated(cfg);
 }
 
-// Wall seconds of an iteration's tests on the fit's further packings.
-double more_seconds(const Iteration& it) {
-  double s = 0;
-  for (const PackingRun& r : it.more) s += r.ucs.seconds + r.br.seconds;
-  return s;
-}
-
 // Everything one calibration run needs, gathered from the case.
 class Calibration {
  public:
@@ -244,7 +237,7 @@ void Calibration::run() {
         it.scb ? fmt::format(", K_IC {} ({:.3f})", it.scb->summary(), t.toughness / 1e6) : "",
         it.converged ? ": all within tolerance" : "", it.ucs.seconds, it.br.seconds,
         it.scb ? fmt::format(" + {:.0f} s", it.scb->seconds) : "",
-        more.empty() ? "" : fmt::format(" + {:.0f} s on the other packings", more_seconds(it))));
+        more.empty() ? "" : fmt::format(" + {:.0f} s on the other packings", it.more_seconds())));
     if (it.scb && !it.scb->peaked)
       notes.push_back(fmt::format(
           "iteration {}: the semi-circular bend test reached its cap still loading", k));

@@ -46,6 +46,12 @@ Measured Iteration::measured() const {
   return {mean_of(E, true), mean_of(nu, false), mean_of(u, true), mean_of(t, true)};
 }
 
+double Iteration::more_seconds() const {
+  double s = 0;
+  for (const PackingRun& r : more) s += r.ucs.seconds + r.br.seconds;
+  return s;
+}
+
 // Errors of one iteration against the ore card and whether all are met.
 void Fitting::score(Iteration& it) const {
   const Measured m = it.measured();
@@ -141,7 +147,8 @@ BondParams Fitting::joint_update(const std::vector<Iteration>& hist,
   const Iteration& now = hist.back();
   BondParams p = now.p;
   const double want = t_.ucs / t_.tensile;
-  const double have = now.measured().ucs / now.measured().tensile;
+  const Measured m = now.measured();
+  const double have = m.ucs / m.tensile;
   // The local model from the last kModelPoints iterations (far points bend
   // a linear model).
   std::vector<ModelPointN<kFitResponses>> pts;

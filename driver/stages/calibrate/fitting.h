@@ -58,6 +58,8 @@ struct Iteration {
   std::optional<ScbRun> scb;
   // The responses the fit aims at the ore card: the means over all packings.
   Measured measured() const;
+  // Wall seconds of the tests on the fit's further packings.
+  double more_seconds() const;
   double err_E = 0, err_ucs = 0, err_t = 0, err_nu = 0;
   double err_kic = 0;  // relative error of K_IC (0 when not a target)
   bool converged = false;

@@ -35,9 +35,7 @@ nlohmann::json macro(const Iteration& it) {
 
 // Wall seconds of an iteration's tests, every packing's and the bend test's.
 double iteration_seconds(const Iteration& it) {
-  double s = it.ucs.seconds + it.br.seconds + (it.scb ? it.scb->seconds : 0.0);
-  for (const PackingRun& r : it.more) s += r.ucs.seconds + r.br.seconds;
-  return s;
+  return it.ucs.seconds + it.br.seconds + (it.scb ? it.scb->seconds : 0.0) + it.more_seconds();
 }
 
 // A value of a run's info line, 0 when the deck did not write it.

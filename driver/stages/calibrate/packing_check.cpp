@@ -94,15 +94,15 @@ PackingSpread packing_spread(const Iteration& best, long seed, const std::vector
   s.fit_packings = 1 + best.more.size();
   std::vector<double> e{best.ucs.r.youngs_modulus}, nu{best.ucs.r.poisson_ratio},
       ucs{best.ucs.r.ucs}, t{best.br.r.tensile_strength};
-  std::vector<PackingRun> all = best.more;
-  all.insert(all.end(), runs.begin(), runs.end());
-  for (const PackingRun& r : all) {
-    s.seeds.push_back(r.seed);
-    e.push_back(r.ucs.r.youngs_modulus);
-    nu.push_back(r.ucs.r.poisson_ratio);
-    ucs.push_back(r.ucs.r.ucs);
-    t.push_back(r.br.r.tensile_strength);
-  }
+  // The fit's further packings, then the check's (no copies of their curves).
+  for (const std::vector<PackingRun>* group : {&best.more, &runs})
+    for (const PackingRun& r : *group) {
+      s.seeds.push_back(r.seed);
+      e.push_back(r.ucs.r.youngs_modulus);
+      nu.push_back(r.ucs.r.poisson_ratio);
+      ucs.push_back(r.ucs.r.ucs);
+      t.push_back(r.br.r.tensile_strength);
+    }
   s.E = property(std::move(e), tol, false);
   s.nu = property(std::move(nu), nu_tol, true);
   s.ucs = property(std::move(ucs), tol, false);
