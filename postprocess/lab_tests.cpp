@@ -116,25 +116,26 @@ size_t argmax(const std::vector<double>& v) {
 }
 }  // namespace
 
+size_t FailureIndex(const std::vector<double>& values, const std::vector<double>& broken_bonds,
+                    double fraction) {
+  if (broken_bonds.size() != values.size()) return values.size();
+  size_t top = 0;
+  for (size_t i = 1; i < values.size(); ++i) {
+    if (values[i] > values[top])
+      top = i;
+    else if (values[i] < fraction * values[top] && broken_bonds[i] > broken_bonds[top])
+      return i;
+  }
+  return values.size();
+}
+
 // E and nu from the linear part of the loading branch, UCS from the peak.
 UcsResult AnalyseUcs(const StressStrain& s, double lo_frac, double hi_frac) {
   if (s.stress.empty()) throw std::runtime_error("UCS test: empty stress-strain curve");
   UcsResult r;
   // Failure: the stress below kUcsFailureFraction of its running maximum,
   // bonds broken since that maximum.
-  r.failure_index = s.stress.size();
-  if (s.broken_bonds.size() == s.stress.size()) {
-    size_t top = 0;
-    for (size_t i = 1; i < s.stress.size(); ++i) {
-      if (s.stress[i] > s.stress[top]) {
-        top = i;
-      } else if (s.stress[i] < kUcsFailureFraction * s.stress[top] &&
-                 s.broken_bonds[i] > s.broken_bonds[top]) {
-        r.failure_index = i;
-        break;
-      }
-    }
-  }
+  r.failure_index = FailureIndex(s.stress, s.broken_bonds, kUcsFailureFraction);
   r.peak_index = static_cast<size_t>(
       std::max_element(s.stress.begin(), s.stress.begin() + static_cast<long>(r.failure_index)) -
       s.stress.begin());
@@ -180,7 +181,10 @@ BrazilianResult AnalyseBrazilian(const LoadCurve& c, double diameter_m, double t
   BrazilianResult r;
   std::vector<double> f(c.size());
   for (size_t i = 0; i < c.size(); ++i) f[i] = c.force(i);
-  r.peak_index = argmax(f);
+  r.split_index = FailureIndex(f, c.broken_bonds, kBrazilianSplitFraction);
+  r.no_split = r.split_index == f.size();
+  r.peak_index = static_cast<size_t>(
+      std::max_element(f.begin(), f.begin() + static_cast<long>(r.split_index)) - f.begin());
   r.peak_force = f[r.peak_index];
   if (!(r.peak_force > 0))
     throw std::runtime_error("Brazilian test: the disc never carried a load");

@@ -46,8 +46,10 @@ using namespace calibrate;
 // the bonds' critical step with their dashpots (fix bond/breakable f_ID[8]):
 // smaller at high coordination, where the old one created energy. 9: the
 // UCS is the peak before the specimen fails (post::kUcsFailureFraction), not
-// a later one of its debris compacted between the platens.
-constexpr int kDeckVersion = 9;
+// a later one of its debris compacted between the platens. 10: the
+// Brazilian strength is the load at the split (post::kBrazilianSplitFraction)
+// and a disc that does not split gives none.
+constexpr int kDeckVersion = 10;
 
 // The fit's targets: the card's four macro properties, and its K_IC when
 // the fit aims at it.
@@ -253,6 +255,19 @@ void Calibration::run() {
           notes.push_back(fmt::format(
               "iteration {}: the {} test on packing seed {} reached its cap still loading", k, test,
               r.seed));
+    // A disc that did not split has no tensile strength (post::kBrazilianSplitFraction).
+    auto unsplit = [&](const BrazilianRun& b, const std::string& where) {
+      if (!b.r.no_split) return;
+      const std::string text = fmt::format(
+          "iteration {}: the Brazilian disc{} did not split (its load rose to {:.2f} MPa "
+          "as tensile strength without a drop below {:g} x: a crushed disc compacting under "
+          "the jaws): no tensile strength, the iteration is not used",
+          k, where, b.r.tensile_strength / 1e6, post::kBrazilianSplitFraction);
+      notes.push_back(text);
+      ctx_.progress.warn("[calibrate] " + text);
+    };
+    unsplit(it.br, "");
+    for (const PackingRun& r : it.more) unsplit(r.br, fmt::format(" of packing seed {}", r.seed));
     if (it.converged || k == max_it_) break;
     p = fit_.update(hist, notes);
   }

@@ -321,6 +321,43 @@ TEST(Fitting, UnusableFirstIterationIsANamedError) {
   }
 }
 
+// A Brazilian disc that did not split (post::kBrazilianSplitFraction) gives
+// no tensile strength: the iteration is unusable (its T NaN, on one packing
+// or in the mean of several), never within tolerance even when the load it
+// reached matches the card, never the result, and the next step goes back
+// half way towards the last usable parameters.
+TEST(Fitting, DiscThatDidNotSplitIsNoMeasurement) {
+  const Fitting fit(kCard, 0.1);
+  BondParams p0 = start();
+  p0.model = BondModel::flat_joint;
+  BondParams p1 = p0;
+  p1.tensile = 0.25 * p0.tensile;
+  p1.cohesion = 0.25 * p0.cohesion;
+  std::vector<Iteration> hist{made(p0, 18.69e9, 0.18, 30e6, 6e6),
+                              made(p1, 18.69e9, 0.18, 50e6, 5e6)};  // the card's numbers
+  hist[1].br.r.no_split = true;
+  for (auto& it : hist) fit.score(it);
+  EXPECT_TRUE(std::isnan(hist[1].measured().tensile));
+  EXPECT_FALSE(Fitting::usable(hist[1]));
+  EXPECT_FALSE(hist[1].converged);
+  EXPECT_EQ(fit.best(hist), 0u);
+  std::vector<std::string> notes;
+  const BondParams p = fit.update(hist, notes);
+  EXPECT_NEAR(p.tensile / (0.5 * p0.tensile), 1.0, 1e-12);
+  EXPECT_NE(notes.back().find("iteration 2: no usable response"), std::string::npos)
+      << notes.back();
+  // On one of three packings: the mean is no measurement either.
+  Iteration three = made(p0, 18.69e9, 0.18, 50e6, 5e6);
+  three.more = {mill::test::packing_run(2, 18.69e9, 0.18, 50e6, 5e6),
+                mill::test::packing_run(3, 18.69e9, 0.18, 50e6, 5e6)};
+  fit.score(three);
+  EXPECT_TRUE(three.converged);
+  three.more[1].br.r.no_split = true;
+  fit.score(three);
+  EXPECT_TRUE(std::isnan(three.measured().tensile));
+  EXPECT_FALSE(three.converged);
+}
+
 // A NaN anywhere is unusable too.
 TEST(Fitting, NonFiniteResponseIsUnusable) {
   EXPECT_FALSE(Fitting::usable(made(start(), 18e9, NAN, 50e6, 5e6)));

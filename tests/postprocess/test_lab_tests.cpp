@@ -144,6 +144,52 @@ TEST(LabTests, BrazilianPeakLoad) {
   EXPECT_NEAR(r.peak_force, 10e9 * 0.775e-3 * 1e-3, 1e-3 * r.peak_force);
   EXPECT_DOUBLE_EQ(r.tensile_strength, BrazilianTensileStrength(r.peak_force, 0.05, 0.025));
   EXPECT_DOUBLE_EQ(r.displacement_at_peak, c.displacement[r.peak_index]);
+  EXPECT_FALSE(r.no_split);  // the load falls to nothing after the peak, bonds breaking
+}
+
+// The Brazilian strength is the load at the split (kBrazilianSplitFraction):
+// a disc loaded to 2 kN splits (the load falls to 1.2 kN, 300 bonds break),
+// then its halves are loaded up to 3 kN: T from 2 kN, to 1e-12. A disc
+// whose load rises to the end while its bonds break never split
+// (no_split), and a dip to 0.75 x, or one without broken bonds, is no split.
+TEST(LabTests, BrazilianStrengthIsTheLoadAtTheSplit) {
+  LoadCurve c;
+  auto add = [&](double u, double F, double broken) {
+    c.time.push_back(u);
+    c.displacement.push_back(u);
+    c.force_top.push_back(F);
+    c.force_bottom.push_back(F);
+    c.lateral_strain.push_back(0);
+    c.broken_bonds.push_back(broken);
+  };
+  for (int i = 0; i <= 100; ++i) add(1e-7 * i, 20.0 * i, i / 2.0);                     // to 2 kN
+  add(1.01e-5, 1200.0, 350);                                                           // the split
+  for (int i = 1; i <= 100; ++i) add(1.01e-5 + 1e-7 * i, 1200.0 + 18.0 * i, 350 + i);  // to 3 kN
+  const BrazilianResult r = AnalyseBrazilian(c, 0.05, 0.025);
+  EXPECT_FALSE(r.no_split);
+  EXPECT_EQ(r.split_index, 101u);
+  EXPECT_EQ(r.peak_index, 100u);
+  EXPECT_NEAR(r.peak_force, 2000.0, 1e-9);
+  EXPECT_NEAR(r.tensile_strength / BrazilianTensileStrength(2000.0, 0.05, 0.025), 1.0, 1e-12);
+  // The load rising to the end, bonds breaking all along: no split; the
+  // largest load is reported, flagged.
+  LoadCurve crushed = c;
+  for (size_t i = 101; i < crushed.size(); ++i)
+    crushed.force_top[i] = crushed.force_bottom[i] = 2000.0 + 10.0 * static_cast<double>(i - 100);
+  const BrazilianResult k = AnalyseBrazilian(crushed, 0.05, 0.025);
+  EXPECT_TRUE(k.no_split);
+  EXPECT_EQ(k.split_index, crushed.size());
+  EXPECT_EQ(k.peak_index, crushed.size() - 1);
+  // A dip to 0.75 x (above the fraction): no split either.
+  LoadCurve shallow = c;
+  shallow.force_top[101] = shallow.force_bottom[101] = 1500.0;
+  for (size_t i = 102; i < shallow.size(); ++i)
+    shallow.force_top[i] = shallow.force_bottom[i] = std::max(shallow.force_top[i], 1500.0);
+  EXPECT_TRUE(AnalyseBrazilian(shallow, 0.05, 0.025).no_split);
+  // The drop without a broken bond (the jaws seating): no split.
+  LoadCurve seating = c;
+  std::fill(seating.broken_bonds.begin(), seating.broken_bonds.end(), 0.0);
+  EXPECT_TRUE(AnalyseBrazilian(seating, 0.05, 0.025).no_split);
 }
 
 TEST(LabTests, ReadsTheDeckCurveFormatAndNamesABadLine) {

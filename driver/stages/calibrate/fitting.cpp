@@ -28,20 +28,27 @@ double mean_of(const std::vector<double>& v, bool positive) {
   return sum / static_cast<double>(v.size());
 }
 
+// A Brazilian test's tensile strength, NaN when the disc did not split (its
+// largest load is a crushed disc's, post::kBrazilianSplitFraction): no
+// model can use it, so the fit steps back (Fitting::update).
+double tensile_of(const BrazilianRun& b) {
+  return b.r.no_split ? std::numeric_limits<double>::quiet_NaN() : b.r.tensile_strength;
+}
+
 }  // namespace
 
 // The arithmetic means over the packings: a lab's reading of several
-// specimens. With one packing its own values, whatever they are.
+// specimens. With one packing its own values, whatever they are, but for
+// the tensile strength of a disc that did not split.
 Measured Iteration::measured() const {
-  if (more.empty())
-    return {ucs.r.youngs_modulus, ucs.r.poisson_ratio, ucs.r.ucs, br.r.tensile_strength};
+  if (more.empty()) return {ucs.r.youngs_modulus, ucs.r.poisson_ratio, ucs.r.ucs, tensile_of(br)};
   std::vector<double> E{ucs.r.youngs_modulus}, nu{ucs.r.poisson_ratio}, u{ucs.r.ucs},
-      t{br.r.tensile_strength};
+      t{tensile_of(br)};
   for (const PackingRun& r : more) {
     E.push_back(r.ucs.r.youngs_modulus);
     nu.push_back(r.ucs.r.poisson_ratio);
     u.push_back(r.ucs.r.ucs);
-    t.push_back(r.br.r.tensile_strength);
+    t.push_back(tensile_of(r.br));
   }
   return {mean_of(E, true), mean_of(nu, false), mean_of(u, true), mean_of(t, true)};
 }
@@ -66,6 +73,9 @@ void Fitting::score(Iteration& it) const {
                                  : 1e300;
   it.score = std::max({it.err_E / tol_, it.err_ucs / tol_, it.err_t / tol_,
                        it.err_nu / kNuTolerance, it.err_kic / tol_});
+  // A NaN response (a disc that did not split) is no measurement: never
+  // within tolerance, whatever the others say (std::max skips a NaN).
+  if (!usable(it)) it.score = std::numeric_limits<double>::infinity();
   it.converged = it.score <= 1.0;
 }
 
@@ -356,10 +366,12 @@ size_t Fitting::best(const std::vector<Iteration>& hist) const {
     return (it.err_E <= tol_) + (it.err_ucs <= tol_) + (it.err_t <= tol_) +
            (it.err_nu <= kNuTolerance) + (fits_toughness() && it.err_kic <= tol_);
   };
+  // Unusable iterations (a NaN response) are never kept while another is.
   size_t best = 0;
-  for (size_t i = 1; i < hist.size(); ++i)
-    if (met(hist[i]) > met(hist[best]) ||
-        (met(hist[i]) == met(hist[best]) && hist[i].score < hist[best].score))
+  while (best + 1 < hist.size() && !usable(hist[best])) ++best;
+  for (size_t i = best + 1; i < hist.size(); ++i)
+    if (usable(hist[i]) && (met(hist[i]) > met(hist[best]) ||
+                            (met(hist[i]) == met(hist[best]) && hist[i].score < hist[best].score)))
       best = i;
   return best;
 }

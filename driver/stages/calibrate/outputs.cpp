@@ -218,6 +218,7 @@ nlohmann::json Report::json() const {
          {"brazilian_peak_force_N", it.br.r.peak_force},
          {"ucs_peaked", it.ucs.peaked},
          {"brazilian_peaked", it.br.peaked},
+         {"brazilian_split", !it.br.r.no_split},
          {"energy",
           {{"ucs", lab_energy_json(it.ucs.energy)}, {"brazilian", lab_energy_json(it.br.energy)}}},
          {"wall_seconds", iteration_seconds(it)}});
