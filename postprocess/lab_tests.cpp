@@ -44,6 +44,7 @@ void AppendLoadRow(const std::vector<double>& r, LoadCurve& c) {
   c.force_top.push_back(r[3]);
   c.force_bottom.push_back(r[4]);
   c.lateral_strain.push_back(r[5]);
+  c.intact_bonds.push_back(r[6]);
   c.broken_bonds.push_back(r[7]);
 }
 }  // namespace
@@ -182,7 +183,12 @@ BrazilianResult AnalyseBrazilian(const LoadCurve& c, double diameter_m, double t
   std::vector<double> f(c.size());
   for (size_t i = 0; i < c.size(); ++i) f[i] = c.force(i);
   r.split_index = FailureIndex(f, c.broken_bonds, kBrazilianSplitFraction);
-  r.no_split = r.split_index == f.size();
+  // No split, and the disc has lost kBrazilianCrushedLoss of its bonds or
+  // more: crushed. With fewer lost it is still whole at the run's end: the
+  // largest load is a lower bound, as before (the stage notes the cap).
+  const bool counts = c.intact_bonds.size() == f.size() && !f.empty() && c.intact_bonds[0] > 0;
+  r.bonds_lost = counts ? 1.0 - c.intact_bonds.back() / c.intact_bonds.front() : 0.0;
+  r.no_split = r.split_index == f.size() && r.bonds_lost >= kBrazilianCrushedLoss;
   r.peak_index = static_cast<size_t>(
       std::max_element(f.begin(), f.begin() + static_cast<long>(r.split_index)) - f.begin());
   r.peak_force = f[r.peak_index];

@@ -127,7 +127,11 @@ def plot_convergence(report, out):
     if "fracture_toughness" in t:
         props.append(("fracture_toughness", "K_IC"))
     for key, name in props:
-        ax.plot(its, [i["achieved"][key] / t[key] for i in report["iterations"]], "o-", label=name)
+        # An iteration without a measurement (null: e.g. a Brazilian disc that
+        # did not split) leaves a gap in its line.
+        ratio = [float("nan") if i["achieved"].get(key) is None else i["achieved"][key] / t[key]
+                 for i in report["iterations"]]
+        ax.plot(its, ratio, "o-", label=name)
     ax.axhspan(1 - tol, 1 + tol, color="green", alpha=0.15, label=f"+-{100 * tol:.0f}%")
     ax.set_xlabel("iteration")
     ax.set_ylabel("achieved / target")

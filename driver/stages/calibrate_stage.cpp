@@ -259,10 +259,12 @@ void Calibration::run() {
     auto unsplit = [&](const BrazilianRun& b, const std::string& where) {
       if (!b.r.no_split) return;
       const std::string text = fmt::format(
-          "iteration {}: the Brazilian disc{} did not split (its load rose to {:.2f} MPa "
-          "as tensile strength without a drop below {:g} x: a crushed disc compacting under "
-          "the jaws): no tensile strength, the iteration is not used",
-          k, where, b.r.tensile_strength / 1e6, post::kBrazilianSplitFraction);
+          "iteration {}: the Brazilian disc{} did not split: it lost {:.0f}% of its bonds and "
+          "its load, {:.2f} MPa as tensile strength at most, never fell below {:g} x its "
+          "highest (a crushed disc compacting under the jaws): no tensile strength, the "
+          "iteration is not used",
+          k, where, 100 * b.r.bonds_lost, b.r.tensile_strength / 1e6,
+          post::kBrazilianSplitFraction);
       notes.push_back(text);
       ctx_.progress.warn("[calibrate] " + text);
     };

@@ -148,10 +148,13 @@ TEST(LabTests, BrazilianPeakLoad) {
 }
 
 // The Brazilian strength is the load at the split (kBrazilianSplitFraction):
-// a disc loaded to 2 kN splits (the load falls to 1.2 kN, 300 bonds break),
-// then its halves are loaded up to 3 kN: T from 2 kN, to 1e-12. A disc
-// whose load rises to the end while its bonds break never split
-// (no_split), and a dip to 0.75 x, or one without broken bonds, is no split.
+// a disc of 1000 bonds loaded to 2 kN splits (the load falls to 1.2 kN, 300
+// bonds break), then its halves are loaded up to 3 kN: T from 2 kN, to
+// 1e-12. A disc whose load rises to the end while 45 % of its bonds break
+// was crushed (no_split), and so was one with a dip to 0.75 x only. A drop
+// without a broken bond is no split, and a disc that lost under
+// kBrazilianCrushedLoss of its bonds is whole at the end: its largest load
+// is kept (a lower bound), not flagged.
 TEST(LabTests, BrazilianStrengthIsTheLoadAtTheSplit) {
   LoadCurve c;
   auto add = [&](double u, double F, double broken) {
@@ -160,6 +163,7 @@ TEST(LabTests, BrazilianStrengthIsTheLoadAtTheSplit) {
     c.force_top.push_back(F);
     c.force_bottom.push_back(F);
     c.lateral_strain.push_back(0);
+    c.intact_bonds.push_back(1000.0 - broken);
     c.broken_bonds.push_back(broken);
   };
   for (int i = 0; i <= 100; ++i) add(1e-7 * i, 20.0 * i, i / 2.0);                     // to 2 kN
@@ -186,10 +190,27 @@ TEST(LabTests, BrazilianStrengthIsTheLoadAtTheSplit) {
   for (size_t i = 102; i < shallow.size(); ++i)
     shallow.force_top[i] = shallow.force_bottom[i] = std::max(shallow.force_top[i], 1500.0);
   EXPECT_TRUE(AnalyseBrazilian(shallow, 0.05, 0.025).no_split);
-  // The drop without a broken bond (the jaws seating): no split.
+  // The drop without a broken bond (the jaws seating): no split, and no bond
+  // lost: whole, the curve's largest load.
   LoadCurve seating = c;
   std::fill(seating.broken_bonds.begin(), seating.broken_bonds.end(), 0.0);
-  EXPECT_TRUE(AnalyseBrazilian(seating, 0.05, 0.025).no_split);
+  std::fill(seating.intact_bonds.begin(), seating.intact_bonds.end(), 1000.0);
+  const BrazilianResult w = AnalyseBrazilian(seating, 0.05, 0.025);
+  EXPECT_FALSE(w.no_split);
+  EXPECT_EQ(w.split_index, seating.size());
+  EXPECT_NEAR(w.peak_force, 3000.0, 1e-9);
+  // Rising to the end with 2 % of the bonds broken (a strong disc at its
+  // cap): whole, its largest load kept.
+  LoadCurve strong = crushed;
+  for (size_t i = 0; i < strong.size(); ++i) {
+    strong.broken_bonds[i] = std::min(strong.broken_bonds[i], 20.0);
+    strong.intact_bonds[i] = 1000.0 - strong.broken_bonds[i];
+  }
+  const BrazilianResult g = AnalyseBrazilian(strong, 0.05, 0.025);
+  EXPECT_FALSE(g.no_split);
+  EXPECT_NEAR(g.bonds_lost, 0.02, 1e-12);
+  EXPECT_EQ(g.peak_index, strong.size() - 1);
+  EXPECT_NEAR(k.bonds_lost, 0.45, 1e-12);
 }
 
 TEST(LabTests, ReadsTheDeckCurveFormatAndNamesABadLine) {
