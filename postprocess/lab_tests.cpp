@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -111,9 +112,10 @@ LinearFit FitLine(const std::vector<double>& x, const std::vector<double>& y, si
 }
 
 namespace {
-// Index of the largest value (first one on ties).
-size_t argmax(const std::vector<double>& v) {
-  return static_cast<size_t>(std::max_element(v.begin(), v.end()) - v.begin());
+// Index of the largest value among the first `end` (first one on ties).
+size_t argmax(const std::vector<double>& v, size_t end = SIZE_MAX) {
+  const auto last = v.begin() + static_cast<long>(std::min(end, v.size()));
+  return static_cast<size_t>(std::max_element(v.begin(), last) - v.begin());
 }
 }  // namespace
 
@@ -137,9 +139,7 @@ UcsResult AnalyseUcs(const StressStrain& s, double lo_frac, double hi_frac) {
   // Failure: the stress below kUcsFailureFraction of its running maximum,
   // bonds broken since that maximum.
   r.failure_index = FailureIndex(s.stress, s.broken_bonds, kUcsFailureFraction);
-  r.peak_index = static_cast<size_t>(
-      std::max_element(s.stress.begin(), s.stress.begin() + static_cast<long>(r.failure_index)) -
-      s.stress.begin());
+  r.peak_index = argmax(s.stress, r.failure_index);
   r.ucs = s.stress[r.peak_index];
   r.strain_at_peak = s.strain[r.peak_index];
   if (!(r.ucs > 0))
@@ -189,8 +189,7 @@ BrazilianResult AnalyseBrazilian(const LoadCurve& c, double diameter_m, double t
   const bool counts = c.intact_bonds.size() == f.size() && !f.empty() && c.intact_bonds[0] > 0;
   r.bonds_lost = counts ? 1.0 - c.intact_bonds.back() / c.intact_bonds.front() : 0.0;
   r.no_split = r.split_index == f.size() && r.bonds_lost >= kBrazilianCrushedLoss;
-  r.peak_index = static_cast<size_t>(
-      std::max_element(f.begin(), f.begin() + static_cast<long>(r.split_index)) - f.begin());
+  r.peak_index = argmax(f, r.split_index);
   r.peak_force = f[r.peak_index];
   if (!(r.peak_force > 0))
     throw std::runtime_error("Brazilian test: the disc never carried a load");
