@@ -66,6 +66,18 @@ def poisson(stress, strain, lateral, k):
     return sxy / sxx if sxx > 0 else None
 
 
+def direct_tension(out, model):
+    """Direct tensile strength: the peak of the mean grip force over the
+    cylinder's cross-section; None when the tension test did not run."""
+    try:
+        ti = info(f"{out}/{model}/tension/tension_info.txt")
+    except FileNotFoundError:
+        return None
+    tc = curve(f"{out}/{model}/tension/tension_curve.txt")
+    d = float(ti["diameter"])
+    return max(0.5 * (r[3] + r[4]) for r in tc) / (math.pi * d * d / 4)
+
+
 def toughness(out, model):
     """K_IC = Y' P sqrt(pi a) / (2 R B), Y' of Kuruppu et al. (2014), eq. 2;
     None when the SCB test did not run."""
@@ -85,17 +97,20 @@ def toughness(out, model):
 def main():
     out, models = sys.argv[1], sys.argv[2:]
     print("| model | UCS [MPa] | tensile [MPa] | UCS/T | E (secant at UCS/2) [GPa] | nu "
-          "| UCS peaked | K_IC [MPa m^0.5] |")
-    print("|---|---|---|---|---|---|---|---|")
+          "| UCS peaked | K_IC [MPa m^0.5] | direct tension [MPa] | UCS/direct |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for m in models:
         ucs, t, e, nu, peaked, k = analyse(out, m)
         kic = "-" if k is None else f"{k / 1e6:.3f}"
+        dt = direct_tension(out, m)
+        dts = "-" if dt is None else f"{dt / 1e6:.2f}"
+        ratio = "-" if dt is None or ucs is None else f"{ucs / dt:.2f}"
         if ucs is None:
-            print(f"| {m} | - | - | - | - | - | - | {kic} |")
+            print(f"| {m} | - | - | - | - | - | - | {kic} | {dts} | - |")
             continue
         nus = "-" if nu is None else f"{nu:.3f}"
         print(f"| {m} | {ucs / 1e6:.1f} | {t / 1e6:.2f} | {ucs / t:.2f} | {e / 1e9:.1f} | {nus} | "
-              f"{'yes' if peaked else 'no (cap reached)'} | {kic} |")
+              f"{'yes' if peaked else 'no (cap reached)'} | {kic} | {dts} | {ratio} |")
 
 
 if __name__ == "__main__":

@@ -66,9 +66,12 @@ model_keys() {  # model -> keywords
 run_test() {
   dir="$out/$4/$1"
   mkdir -p "$dir"
-  cp "$root/liggghts_inputs/$1.in.tmpl" "$dir/$1.in"
+  deck=$1 pull=0
+  [ "$1" = tension ] && deck=ucs pull=1  # the direct tension test: the UCS cylinder pulled
+  cp "$root/liggghts_inputs/$deck.in.tmpl" "$dir/$1.in"
   peak=$3
   (cd "$dir" && "$exe" -in "$1.in" -log liggghts.log -screen none \
+      -var pull "$pull" -var curve_file "$1_curve.txt" -var info_file "$1_info.txt" \
       -var specimen_file "$spec/ball.data" -var carve_r "$2" -var strain_rate "$rate" \
       -var max_strain "$(awk "BEGIN{print $5 * $peak}")" \
       -var sample_time "$(awk "BEGIN{print $peak / $rate / 300}")" \
@@ -95,6 +98,10 @@ for m in $models; do
   esac
   case " $tests " in *" brazilian "*)
     run_test brazilian "$disc_r" "$(awk "BEGIN{print 4 * $tensile_target / $E}")" "$m" 5.0 ;;
+  esac
+  # The direct tension test (tests="... tension"): the UCS cylinder pulled apart by its end layers.
+  case " $tests " in *" tension "*)
+    run_test tension "$ucs_r" "$(awk "BEGIN{print $tensile_target / $E}")" "$m" 8.0 ;;
   esac
   # The toughness check's half disc (its radius: scb_r, default the disc's) (driver/stages/calibrate/lab_runs.cpp, LabBench::scb).
   case " $tests " in *" scb "*)

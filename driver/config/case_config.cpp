@@ -488,7 +488,8 @@ nlohmann::json ore_keys(const Document& ore) {
   };
   for (auto it = all.begin(); it != all.end(); ++it)
     if (it.key() != "name" && it.key() != "source" && it.key().rfind("calibrated.", 0) != 0 &&
-        it.key().rfind("jk.", 0) != 0 && it.key() != kAllowOutsideRange && !is_check(it.key()))
+        it.key().rfind("jk.", 0) != 0 && it.key() != kAllowOutsideRange && !is_check(it.key()) &&
+        it.key() != "rock_class" && it.key() != "direct_tensile_strength")
       out[it.key()] = it.value();
   return out;
 }
@@ -846,6 +847,17 @@ CaseConfig load_case(const fs::path& file, const fs::path& project_dir,
   c.ore_file = resolve_ore(c.doc, file, project_dir);
   c.ore = Document::load(c.ore_file, ore_schema());
   check_ore(c.ore);
+  // The direct tension test's target (lump/material.h, tensile_target).
+  if (c.doc.str("calibrate.tensile_test") == "direct" && !c.ore.has("direct_tensile_strength") &&
+      !c.ore.has("rock_class"))
+    throw ConfigError(fmt::format(
+        "{}: calibrate.tensile_test is direct but the ore card {} gives neither "
+        "direct_tensile_strength "
+        "[Pa] nor rock_class (sedimentary, igneous or metamorphic, to convert its Brazilian "
+        "tensile_strength: Perras & Diederichs 2014): add one to the card, or set "
+        "calibrate.tensile_test: "
+        "brazilian",
+        c.doc.where("calibrate.tensile_test"), c.ore_file.string()));
   return c;
 }
 

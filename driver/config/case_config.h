@@ -84,8 +84,10 @@ nlohmann::json outliers(const CaseConfig& c);
 std::string read_regular_file(const std::filesystem::path& file, const std::string& what);
 
 // The ore card's macro properties (everything but name, source, calibrated.*,
-// jk.*, allow_outside_range and the calibration's check keys kOreCheckKeys),
-// as canonical JSON: what job ids hash and a calibration is fitted to.
+// jk.*, allow_outside_range, the calibration's check keys kOreCheckKeys and
+// rock_class and direct_tensile_strength, which act only through the target
+// of a direct-tension fit, hashed where used: calibration_hash), as
+// canonical JSON: what job ids hash and a calibration is fitted to.
 nlohmann::json ore_keys(const Document& ore);
 
 // Physical consistency of an ore card (UCS > tensile strength, ...).

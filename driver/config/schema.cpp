@@ -536,6 +536,18 @@ std::vector<KeyDef> calibrate_keys() {
                 "(docs/calibration.md, "
                 "\"The toughness as a target\"). Each half disc costs a few seconds per bend test"),
             1, false, 12, false),
+      choice("calibrate.tensile_test", "brazilian", {"brazilian", "direct"},
+             "The virtual test the fit aims the tensile strength at: brazilian (the ore card's "
+             "tensile_strength, a Brazilian disc) or direct (a direct tension test: the UCS "
+             "cylinder pulled "
+             "apart by its end layers, aimed at the card's direct_tensile_strength, else at its "
+             "Brazilian "
+             "strength x f of its rock_class, DTS = f BTS with f 0.7 sedimentary, 0.8 igneous, 0.9 "
+             "metamorphic, Perras & Diederichs 2014). A bonded packing's Brazilian disc can fail "
+             "by shear "
+             "and crushing under the jaws instead of a tensile split (flat joints: "
+             "docs/calibration.md, "
+             "\"The direct tension test\"); the Brazilian test still runs and is reported"),
       key("calibrate.rate_check", T::Bool, "", "true",
           "After the fit, repeat the UCS test at half the strain rate (quasi-static check)"),
       range(key("calibrate.fit_packings", T::Int, "", "1",
@@ -619,45 +631,81 @@ Schema make_ore_schema() {
   s.keys = {
       key("name", T::String, "", "", "Ore name"),
       opt(key("source", T::String, "", "", "Where the values come from (citation)")),
-      plausible(positive(key("density", T::Real, "kg/m^3", "", "Bulk density")), 1000, 8000, "a rock's density",
-                kRockDensitySource, {{"g/cm^3", 1e3}}),
+      plausible(positive(key("density", T::Real, "kg/m^3", "", "Bulk density")), 1000, 8000,
+                "a rock's density", kRockDensitySource, {{"g/cm^3", 1e3}}),
       plausible(positive(key("youngs_modulus", T::Real, "Pa", "", "Young's modulus E")), 5e8, 2e11,
                 "a rock's Young's modulus", kRockModulusSource, kPascalSlips),
-      plausible(range(key("poisson_ratio", T::Real, "", "", "Poisson's ratio nu"), 0, false, 0.5, true), 0.01, 0.45,
-                "a rock's Poisson's ratio", kPoissonSource, {{"%", 0.01}}),
+      plausible(
+          range(key("poisson_ratio", T::Real, "", "", "Poisson's ratio nu"), 0, false, 0.5, true),
+          0.01, 0.45, "a rock's Poisson's ratio", kPoissonSource, {{"%", 0.01}}),
       plausible(positive(key("ucs", T::Real, "Pa", "", "Uniaxial compressive strength")), 1e6, 5e8,
                 "a rock's uniaxial compressive strength", kUcsSource, kPascalSlips),
-      plausible(positive(key("tensile_strength", T::Real, "Pa", "", "Tensile strength (Brazilian)")), 1e5, 5e7,
-                "a rock's tensile strength", kTensileSource, kPascalSlips),
-      plausible(at_least(key("friction", T::Real, "", "0.5", "Coulomb friction coefficient (element-element and walls)"), 0),
+      plausible(
+          positive(key("tensile_strength", T::Real, "Pa", "", "Tensile strength (Brazilian)")), 1e5,
+          5e7, "a rock's tensile strength", kTensileSource, kPascalSlips),
+      plausible(at_least(key("friction", T::Real, "", "0.5",
+                             "Coulomb friction coefficient (element-element and walls)"),
+                         0),
                 0.05, 1.5, "a rock's friction coefficient", kRockFrictionSource),
-      range(key("restitution", T::Real, "", "0.5", "Coefficient of restitution"), 0, true, 1, false),
+      range(key("restitution", T::Real, "", "0.5", "Coefficient of restitution"), 0, true, 1,
+            false),
       // The rock's failure envelope and toughness, optional: the calibration
       // checks its result against them (docs/calibration.md, "Checks after
       // the fit"); they change no simulation and no fitted parameter.
       opt(plausible(range(key("friction_angle", T::Real, "deg", "",
-                              "Internal friction angle phi of the intact rock (Mohr-Coulomb, from triaxial tests "
-                              "over the calibration's confinement, calibrate.confining_pressures); the calibration "
+                              "Internal friction angle phi of the intact rock (Mohr-Coulomb, from "
+                              "triaxial tests "
+                              "over the calibration's confinement, calibrate.confining_pressures); "
+                              "the calibration "
                               "reports its envelope against it (a check, not fitted)"),
                           0, true, 90, true),
                     10, 70, "a rock's internal friction angle", kFrictionAngleSource)),
-      opt(plausible(positive(key("hoek_brown_mi", T::Real, "", "",
-                                 "Hoek-Brown constant m_i of the intact rock (Hoek & Brown 1997); the calibration "
-                                 "reports its envelope's m_i against it (a check, not fitted)")),
-                    1, 50, "a rock's Hoek-Brown m_i", kHoekBrownMiSource)),
-      opt(plausible(positive(key("fracture_toughness", T::Real, "Pa m^0.5", "",
-                                 "Mode-I fracture toughness K_IC; given, the calibration runs a semi-circular bend "
-                                 "test (Kuruppu et al. 2014) and reports its K_IC against it; with flat joints it is also a "
-                                 "target of the fit (calibrate.fit_toughness), with the parallel bond a check only")),
-                    2e4, 1e7, "a rock's mode-I fracture toughness", kToughnessSource,
-                    {{"kPa m^0.5", 1e3}, {"MPa m^0.5", 1e6}})),
+      opt(plausible(
+          positive(
+              key("hoek_brown_mi", T::Real, "", "",
+                  "Hoek-Brown constant m_i of the intact rock (Hoek & Brown 1997); the calibration "
+                  "reports its envelope's m_i against it (a check, not fitted)")),
+          1, 50, "a rock's Hoek-Brown m_i", kHoekBrownMiSource)),
+      opt(plausible(
+          positive(key(
+              "fracture_toughness", T::Real, "Pa m^0.5", "",
+              "Mode-I fracture toughness K_IC; given, the calibration runs a semi-circular bend "
+              "test (Kuruppu et al. 2014) and reports its K_IC against it; with flat joints it is "
+              "also a "
+              "target of the fit (calibrate.fit_toughness), with the parallel bond a check only")),
+          2e4, 1e7, "a rock's mode-I fracture toughness", kToughnessSource,
+          {{"kPa m^0.5", 1e3}, {"MPa m^0.5", 1e6}})),
+      // The tensile strength in direct tension, optional: the target of a fit
+      // with calibrate.tensile_test direct (docs/calibration.md, "The direct
+      // tension test"); the card's tensile_strength is the Brazilian one.
+      opt(choice(
+          "rock_class", "", {"sedimentary", "igneous", "metamorphic"},
+          "The rock's origin, for the direct tensile strength when the card gives none: DTS = f x "
+          "tensile_strength with f 0.7 (sedimentary), 0.8 (igneous) or 0.9 (metamorphic) (Perras & "
+          "Diederichs 2014, Geotech. Geol. Eng. 32); read only with calibrate.tensile_test "
+          "direct")),
+      opt(plausible(
+          positive(
+              key("direct_tensile_strength", T::Real, "Pa", "",
+                  "Tensile strength in direct (uniaxial) tension, when the lab measured it; the "
+                  "target of a fit with calibrate.tensile_test direct (else rock_class converts "
+                  "tensile_strength)")),
+          1e5, 5e7, "a rock's tensile strength", kTensileSource, kPascalSlips)),
       // Measured JK drop-weight parameters (Napier-Munn et al. 1996), optional:
       // drawn against the breakage sweep's own fit; they change no simulation.
-      opt(range(key("jk.A", T::Real, "%", "", "Measured JK breakage parameter A: the largest t10 of the ore (drop-weight test); give with jk.b"), 0, true, 100, false)),
-      opt(range(key("jk.b", T::Real, "t/kWh", "", "Measured JK breakage parameter b (t10 = A (1 - exp(-b Ecs)), Ecs in kWh/t); give with jk.A"), 0, true, 100, false)),
-      opt(key("jk.source", T::String, "", "", "Where the measured A and b come from (laboratory, report)")),
+      opt(range(key("jk.A", T::Real, "%", "",
+                    "Measured JK breakage parameter A: the largest t10 of the ore (drop-weight "
+                    "test); give with jk.b"),
+                0, true, 100, false)),
+      opt(range(key("jk.b", T::Real, "t/kWh", "",
+                    "Measured JK breakage parameter b (t10 = A (1 - exp(-b Ecs)), Ecs in kWh/t); "
+                    "give with jk.A"),
+                0, true, 100, false)),
+      opt(key("jk.source", T::String, "", "",
+              "Where the measured A and b come from (laboratory, report)")),
       opt(key(kAllowOutsideRange, T::KeyList, "", "",
-              "Keys of this card whose values may lie outside their plausible range (a deliberate outlier, e.g. "
+              "Keys of this card whose values may lie outside their plausible range (a deliberate "
+              "outlier, e.g. "
               "[ucs]); recorded in resolved_case.json and the report")),
   };
   // Calibrated micro parameters (written by `--stage calibrate`, optional):

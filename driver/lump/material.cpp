@@ -40,9 +40,37 @@ nlohmann::json lump_scale(const config::CaseConfig& cfg) {
   return s;
 }
 
+double direct_over_brazilian(const config::Document& ore) {
+  if (!ore.has("rock_class"))
+    throw config::ConfigError(fmt::format(
+        "{}: rock_class is not given: calibrate.tensile_test direct needs the card's "
+        "direct_tensile_strength [Pa] or its rock_class (sedimentary, igneous or metamorphic) to "
+        "convert tensile_strength (Perras & Diederichs 2014)",
+        ore.file()));
+  const std::string c = ore.str("rock_class");
+  if (c == "sedimentary") return 0.7;
+  if (c == "igneous") return 0.8;
+  if (c == "metamorphic") return 0.9;
+  throw config::ConfigError(
+      fmt::format("{}: rock_class: expected sedimentary, igneous or metamorphic, got '{}'",
+                  ore.where("rock_class"), c));
+}
+
+bool fits_direct_tension(const config::CaseConfig& cfg) {
+  return cfg.doc.str("calibrate.tensile_test") == "direct";
+}
+
+double tensile_target(const config::CaseConfig& cfg) {
+  const config::Document& o = cfg.ore;
+  if (!fits_direct_tension(cfg)) return o.real("tensile_strength");
+  if (o.has("direct_tensile_strength")) return o.real("direct_tensile_strength");
+  return direct_over_brazilian(o) * o.real("tensile_strength");
+}
+
 std::string calibration_hash(const config::CaseConfig& cfg) {
   nlohmann::json keys = {{"ore", config::ore_keys(cfg.ore)}, {"lump_scale", lump_scale(cfg)}};
   if (fits_toughness(cfg)) keys["fracture_toughness"] = cfg.ore.real("fracture_toughness");
+  if (fits_direct_tension(cfg)) keys["direct_tensile_strength"] = tensile_target(cfg);
   return jobs::job_id(keys);
 }
 

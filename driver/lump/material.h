@@ -22,6 +22,23 @@ std::string ore_hash(const config::Document& ore);
 // fracture_toughness): docs/calibration.md, "The toughness as a target".
 bool fits_toughness(const config::CaseConfig& cfg);
 
+// Perras & Diederichs (2014, Geotech. Geol. Eng. 32, abstract and sec. 6):
+// the direct tensile strength over the Brazilian one, DTS = f BTS, by the
+// ore card's rock_class (0.7 sedimentary, 0.8 igneous, 0.9 metamorphic).
+// Throws ConfigError naming the card and the key for any other class.
+double direct_over_brazilian(const config::Document& ore);
+
+// True when the fit aims its tensile strength at a direct tension test
+// (calibrate.tensile_test direct): docs/calibration.md, "The direct tension
+// test".
+bool fits_direct_tension(const config::CaseConfig& cfg);
+
+// The tensile strength the fit aims at: the card's tensile_strength
+// (Brazilian), or with fits_direct_tension its direct_tensile_strength,
+// else tensile_strength x direct_over_brazilian. Throws ConfigError naming
+// the keys when the direct test has neither.
+double tensile_target(const config::CaseConfig& cfg);
+
 // The lump's material scale, which a calibration holds for and no other:
 // the mean element radius (lump.n_elements in lump.diameter with
 // lump.radius_spread: a bonded packing's strengths and toughness follow it,
@@ -34,7 +51,8 @@ nlohmann::json lump_scale(const config::CaseConfig& cfg);
 // The input_hash that ties a calibration to what it was fitted to: the
 // card's macro properties (ore_hash), its fracture_toughness when the fit
 // aimed at it (fits_toughness), so that a section fitted to another K_IC is
-// not taken for this card's, and the lump's scale (lump_scale), so that a
+// not taken for this card's, the direct tensile strength when the fit aimed
+// at it (fits_direct_tension), and the lump's scale (lump_scale), so that a
 // section fitted at another element size or bonding range is not either.
 std::string calibration_hash(const config::CaseConfig& cfg);
 

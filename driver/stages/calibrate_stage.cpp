@@ -55,8 +55,9 @@ constexpr int kDeckVersion = 10;
 // the fit aims at it.
 Targets targets_of(const config::CaseConfig& cfg) {
   const config::Document& o = cfg.ore;
-  Targets t{o.real("youngs_modulus"), o.real("poisson_ratio"), o.real("ucs"),
-            o.real("tensile_strength")};
+  Targets t{o.real("youngs_modulus"), o.real("poisson_ratio"), o.real("ucs"), tensile_target(cfg)};
+  t.direct = fits_direct_tension(cfg);
+  t.brazilian = o.real("tensile_strength");
   if (fits_toughness(cfg)) t.toughness = o.real("fracture_toughness");
   return t;
 }
@@ -183,9 +184,14 @@ void Calibration::run() {
   const int n_packings = primary ? static_cast<int>(d_.integer("calibrate.packing_check")) : 0;
   const double n_sensitivity =
       sensitivity ? 2.0 * static_cast<double>(sensitivity_levers(p).size()) : 0.0;
-  const double per_it = 2.0 * fit_packings_ + (fit_.fits_toughness() ? 1.0 : 0.0);
-  const double steps_total =
-      per_it * max_it_ + (rate_check ? 2.0 : 0.0) + 2.0 * n_packings + n_sensitivity + n_checks;
+  // Tests per packing: UCS and Brazilian, or with the direct tension test as
+  // the fit's tensile test UCS and direct tension (the Brazilian discs then
+  // run once, on the kept parameters: a check).
+  const double per_packing = 2.0;
+  const double per_it = per_packing * fit_packings_ + (fit_.fits_toughness() ? 1.0 : 0.0);
+  const double disc_check = t.direct ? static_cast<double>(fit_packings_) : 0.0;
+  const double steps_total = per_it * max_it_ + disc_check + (rate_check ? 2.0 : 0.0) +
+                             2.0 * n_packings + n_sensitivity + n_checks;
   for (int k = 1; k <= max_it_; ++k) {
     Iteration it;
     it.p = p;
@@ -193,51 +199,66 @@ void Calibration::run() {
     // The UCS and the Brazilian test of every packing, side by side as the
     // job's lanes allow.
     const double at = per_it * (k - 1);
-    std::vector<std::function<void()>> tests = {
-        [&] {
-          it.ucs = lab.ucs(p, rate_,
-                           {fmt::format("it{}_ucs", k),
-                            fmt::format("iteration {}/{}: UCS", k, max_it_), at / steps_total});
-        },
-        [&] {
-          it.br = lab.brazilian(
-              p, rate_,
-              {fmt::format("it{}_brazilian", k),
-               fmt::format("iteration {}/{}: Brazilian", k, max_it_), (at + 1) / steps_total});
-        }};
+    std::vector<std::function<void()>> tests = {[&] {
+      it.ucs = lab.ucs(p, rate_,
+                       {fmt::format("it{}_ucs", k), fmt::format("iteration {}/{}: UCS", k, max_it_),
+                        at / steps_total});
+    }};
+    if (t.direct)
+      tests.push_back([&] {
+        it.tension = lab.tension(
+            p, rate_,
+            {fmt::format("it{}_tension", k),
+             fmt::format("iteration {}/{}: direct tension", k, max_it_), (at + 1) / steps_total});
+      });
+    else
+      tests.push_back([&] {
+        it.br = lab.brazilian(
+            p, rate_,
+            {fmt::format("it{}_brazilian", k),
+             fmt::format("iteration {}/{}: Brazilian", k, max_it_), (at + 1) / steps_total});
+      });
     for (size_t j = 0; j < more.size(); ++j) {
       const std::string of =
           fmt::format("iteration {}/{}, packing {}/{}", k, max_it_, j + 2, fit_packings_);
-      const double at_j = at + 2.0 * static_cast<double>(j + 1);
+      const double at_j = at + per_packing * static_cast<double>(j + 1);
       it.more[j].seed = more_seeds[j];
       tests.push_back([&, j, of, at_j] {
         it.more[j].ucs = more[j].ucs(
             p, rate_, {fmt::format("it{}_p{}_ucs", k, j + 2), of + ": UCS", at_j / steps_total});
       });
-      tests.push_back([&, j, of, at_j] {
-        it.more[j].br = more[j].brazilian(p, rate_,
-                                          {fmt::format("it{}_p{}_brazilian", k, j + 2),
-                                           of + ": Brazilian", (at_j + 1) / steps_total});
-      });
+      if (t.direct)
+        tests.push_back([&, j, of, at_j] {
+          it.more[j].tension = more[j].tension(p, rate_,
+                                               {fmt::format("it{}_p{}_tension", k, j + 2),
+                                                of + ": direct tension", (at_j + 1) / steps_total});
+        });
+      else
+        tests.push_back([&, j, of, at_j] {
+          it.more[j].br = more[j].brazilian(p, rate_,
+                                            {fmt::format("it{}_p{}_brazilian", k, j + 2),
+                                             of + ": Brazilian", (at_j + 1) / steps_total});
+        });
     }
     run_concurrently(tests, lab.lanes());
     if (fit_.fits_toughness())
       it.scb = lab.scb(p, rate_, scb_orientations_,
                        {fmt::format("it{}_scb", k),
                         fmt::format("iteration {}/{}: semi-circular bend", k, max_it_),
-                        (at + 2.0 * fit_packings_) / steps_total});
+                        (at + per_packing * fit_packings_) / steps_total});
     fit_.score(it);
     hist.push_back(it);
     const Measured m = it.measured();
     ctx_.progress.info(fmt::format(
         "[calibrate] iteration {}/{}: E {:.2f} GPa (target {:.2f}), nu {:.3f} ({:.2f}), UCS {:.1f} "
-        "MPa ({:.1f}), tensile "
-        "{:.2f} MPa ({:.2f}){}{}{} [{:.0f} s + {:.0f} s{}]",
-        k, max_it_, m.E / 1e9, t.E / 1e9, m.nu, t.nu, m.ucs / 1e6, t.ucs / 1e6, m.tensile / 1e6,
-        t.tensile / 1e6,
+        "MPa ({:.1f}), {}tensile "
+        "{:.2f} MPa ({:.2f}){}{}{} [{:.0f} s + {:.0f} s{}{}]",
+        k, max_it_, m.E / 1e9, t.E / 1e9, m.nu, t.nu, m.ucs / 1e6, t.ucs / 1e6,
+        t.direct ? "direct " : "", m.tensile / 1e6, t.tensile / 1e6,
         more.empty() ? "" : fmt::format(" (means over {} packings)", fit_packings_),
         it.scb ? fmt::format(", K_IC {} ({:.3f})", it.scb->summary(), t.toughness / 1e6) : "",
-        it.converged ? ": all within tolerance" : "", it.ucs.seconds, it.br.seconds,
+        it.converged ? ": all within tolerance" : "", it.ucs.seconds,
+        it.tension ? it.tension->seconds : it.br.seconds, it.tension ? " (direct tension)" : "",
         it.scb ? fmt::format(" + {:.0f} s", it.scb->seconds) : "",
         more.empty() ? "" : fmt::format(" + {:.0f} s on the other packings", it.more_seconds())));
     if (it.scb && !it.scb->peaked)
@@ -249,8 +270,13 @@ void Calibration::run() {
     if (!it.br.peaked)
       notes.push_back(
           fmt::format("iteration {}: the Brazilian test reached its cap still loading", k));
+    if (it.tension && !it.tension->peaked)
+      notes.push_back(fmt::format(
+          "iteration {}: the direct tension test reached its strain cap still loading", k));
     for (const PackingRun& r : it.more)
-      for (const auto& [done, test] : {std::pair{r.ucs.peaked, "UCS"}, {r.br.peaked, "Brazilian"}})
+      for (const auto& [done, test] : {std::pair{r.ucs.peaked, "UCS"},
+                                       {r.br.peaked, "Brazilian"},
+                                       {!r.tension || r.tension->peaked, "direct tension"}})
         if (!done)
           notes.push_back(fmt::format(
               "iteration {}: the {} test on packing seed {} reached its cap still loading", k, test,
@@ -274,13 +300,38 @@ void Calibration::run() {
     p = fit_.update(hist, notes);
   }
   o.best = fit_.best(hist);
+  // With the direct tension test as the tensile target: the Brazilian discs
+  // of the kept parameters on every fit packing, a check against the card's
+  // Brazilian strength (docs/calibration.md, "The direct tension test").
+  if (t.direct) {
+    Iteration& b = hist[o.best];
+    std::vector<std::function<void()>> discs = {[&] {
+      b.br = lab.brazilian(b.p, rate_,
+                           {"check_brazilian", "check: Brazilian disc of the kept parameters",
+                            per_it * max_it_ / steps_total});
+    }};
+    for (size_t j = 0; j < more.size(); ++j)
+      discs.push_back([&, j] {
+        b.more[j].br = more[j].brazilian(
+            b.p, rate_,
+            {fmt::format("check_p{}_brazilian", j + 2),
+             fmt::format("check: Brazilian disc of the kept parameters, packing {}/{}", j + 2,
+                         fit_packings_),
+             (per_it * max_it_ + static_cast<double>(j + 1)) / steps_total});
+      });
+    run_concurrently(discs, lab.lanes());
+    ctx_.progress.info(fmt::format(
+        "[calibrate] check: the kept parameters' Brazilian strength {:.2f} MPa (the card's {:.2f} "
+        "MPa; not fitted: the direct tension test is the tensile target)",
+        brazilian_mean(b) / 1e6, t.disc_tensile() / 1e6));
+  }
   // Rate check: the best parameters at half the strain rate.
   if (rate_check)
     o.half = lab.ucs(hist[o.best].p, 0.5 * rate_,
                      {"rate_check_ucs", "rate check: UCS at half the strain rate",
-                      per_it * max_it_ / steps_total});
+                      (per_it * max_it_ + disc_check) / steps_total});
   // Packing check: the best parameters on further packings, each its own ball.
-  const double after_rate = per_it * max_it_ + (rate_check ? 2.0 : 0.0);
+  const double after_rate = per_it * max_it_ + disc_check + (rate_check ? 2.0 : 0.0);
   o.packings = run_packings(ctx_, job_.label, dir_, n_, fit_packings_, n_packings, hist[o.best].p,
                             t, rate_, lab.lanes(), after_rate / steps_total, 1.0 / steps_total);
   // The spread over the fit's packings and the check's (with one in all: none).
@@ -320,6 +371,7 @@ void Calibration::run() {
                           (after_rate + 2.0 * n_packings + n_sensitivity) / steps_total,
                           1.0 / steps_total,
                           scb_orientations_, hist[o.best].scb ? &*hist[o.best].scb : nullptr);
+  for (const std::string& f : o.checks.failed) ctx_.progress.warn("[calibrate] check " + f);
   o.checks.toughness_fitted = fit_.fits_toughness();
   o.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_outputs(ctx_, dir_, fit_, o);
@@ -391,6 +443,12 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
   for (const char* k : config::kOreCheckKeys)
     if (ctx.cfg.ore.has(k)) in["ore_checks"][k] = ctx.cfg.ore.real(k);
   in["deck_version"] = kDeckVersion;
+  // The direct tension test and its target, where they act (a calibration
+  // aimed at the Brazilian strength keeps its job id).
+  if (!fits_direct_tension(ctx.cfg))
+    in.erase("calibrate.tensile_test");
+  else
+    in["direct_tensile_strength"] = tensile_target(ctx.cfg);
   const bool from_card = card_is_calibrated(ctx.cfg);
   if (card_has_stale_calibration(ctx.cfg)) {
     // The fit starts from the card's stale calibration (read as the fit
@@ -405,10 +463,11 @@ Plan CalibrateStage::plan(const StageContext& ctx) const {
   }
   // The tests of each iteration (the toughness fit adds the bend test).
   const long fit_packings = ctx.cfg.doc.integer("calibrate.fit_packings");
-  const char* tests = fits_toughness(ctx.cfg)
-                          ? "UCS + Brazilian + semi-circular bend tests (K_IC a "
-                            "target)"
-                          : "UCS + Brazilian tests";
+  const std::string tests =
+      std::string(fits_direct_tension(ctx.cfg) ? "UCS + Brazilian + direct tension (the tensile "
+                                                 "target)"
+                                               : "UCS + Brazilian") +
+      (fits_toughness(ctx.cfg) ? " + semi-circular bend tests (K_IC a target)" : " tests");
   // "400 elements" or "400 elements x 3 packings (their means fitted)".
   const std::string specimens = fmt::format(
       "{} elements{}", ctx.cfg.doc.integer("calibrate.n_elements"),

@@ -21,7 +21,7 @@ inline calibrate::Iteration iteration(const BondParams& p, double E, double nu, 
 // The UCS and Brazilian tests on the packing of first seed `seed`.
 inline calibrate::PackingRun packing_run(long seed, double E, double nu, double ucs, double t) {
   const calibrate::Iteration it = iteration({}, E, nu, ucs, t);
-  calibrate::PackingRun r{seed, it.ucs, it.br};
+  calibrate::PackingRun r{seed, it.ucs, it.br, std::nullopt};
   r.ucs.tag = "packing_ucs";
   r.br.tag = "packing_brazilian";
   return r;

@@ -165,3 +165,46 @@ TEST(CalibrationHash, JointFrictionIsPartOfTheFlatJointsScale) {
   EXPECT_NE(mill::uncalibrated_reason(other, run).find("joint_friction 1 (this case: 0.8)"),
             std::string::npos);
 }
+
+// calibrate.tensile_test direct aims at the card's direct tensile strength,
+// else at its Brazilian one x f of its rock_class (Perras & Diederichs 2014:
+// 0.7 sedimentary, 0.8 igneous, 0.9 metamorphic). The target is hashed where
+// the fit aims at it, and rock_class and direct_tensile_strength change
+// nothing where it does not (a Brazilian fit keeps its hash).
+TEST(CalibrationHash, DirectTensionAimsAtTheConvertedStrengthAndHashesIt) {
+  const mill::test::TempDir dir("mill_cal_direct_" + std::to_string(getpid()));
+  const std::string lump = "{n_elements: 200}";
+  const std::string direct = "calibrate: {tensile_test: direct}\n";
+  // The card with its rock_class line replaced by `extra` (sandstone: 5 MPa Brazilian).
+  auto card = [&](const std::string& name, const std::string& extra, const std::string& cal) {
+    const auto c = with_card(dir / name, 0.73e6, lump, cal);
+    std::ifstream in(dir / name / "card.yaml");
+    std::stringstream text;
+    text << in.rdbuf();
+    std::ofstream(dir / name / "card.yaml")
+        << std::regex_replace(text.str(), std::regex("\nrock_class: [a-z]+"), "\n" + extra);
+    return mill::config::load_case(dir / name / "case.yaml", kProject);
+  };
+  const auto brazilian = card("b", "rock_class: sedimentary", "");
+  EXPECT_FALSE(mill::fits_direct_tension(brazilian));
+  EXPECT_EQ(mill::tensile_target(brazilian), 5e6);
+  const auto sed = card("s", "rock_class: sedimentary", direct);
+  const auto ign = card("i", "rock_class: igneous", direct);
+  const auto met = card("m", "rock_class: metamorphic", direct);
+  EXPECT_TRUE(mill::fits_direct_tension(sed));
+  EXPECT_NEAR(mill::tensile_target(sed), 3.5e6, 1e-6);
+  EXPECT_NEAR(mill::tensile_target(ign), 4.0e6, 1e-6);
+  EXPECT_NEAR(mill::tensile_target(met), 4.5e6, 1e-6);
+  // A measured direct strength wins over the conversion.
+  const auto measured =
+      card("d", "rock_class: sedimentary\ndirect_tensile_strength: 4.2e6", direct);
+  EXPECT_EQ(mill::tensile_target(measured), 4.2e6);
+  // Hashes: the direct target is part of the fit's inputs ...
+  EXPECT_NE(mill::calibration_hash(sed), mill::calibration_hash(brazilian));
+  EXPECT_NE(mill::calibration_hash(sed), mill::calibration_hash(ign));
+  EXPECT_NE(mill::calibration_hash(sed), mill::calibration_hash(measured));
+  // ... and nothing of a Brazilian fit (nor of any other stage: ore_hash).
+  const auto other = card("o", "rock_class: igneous\ndirect_tensile_strength: 4.2e6", "");
+  EXPECT_EQ(mill::calibration_hash(other), mill::calibration_hash(brazilian));
+  EXPECT_EQ(mill::ore_hash(other.ore), mill::ore_hash(brazilian.ore));
+}

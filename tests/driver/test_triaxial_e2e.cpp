@@ -23,6 +23,7 @@
 #include "lump/material.h"
 #include "postprocess/lab_tests.h"
 #include "progress.h"
+#include "stages/calibrate/checks.h"
 #include "stages/calibrate/lab_runs.h"
 #include "stages/calibrate/specimen.h"
 #include "stages/stage.h"
@@ -157,6 +158,54 @@ TEST(TriaxialEnvelope, MiddlePeakLiesOnTheMohrCoulombLineOfTheOuterConfinements)
       predicted / 1e6, 100 * deviation, kElements, sp.cyl_r * 1e3, seconds);
   EXPECT_LE(std::abs(deviation), 0.05) << summary;
   std::cout << summary << "\n";
+}
+
+// A triaxial check whose engine run fails (here a deck the engine rejects
+// at once; measured: a flat joint at bond gap 1.4 under 11.6 MPa of
+// confinement, where the energy ledger stopped an element at 411 m/s) is a
+// failed check, named with its reason in the notes and left out of the
+// envelope, not an exception that throws the calibration's fit away.
+TEST(TriaxialCheck, FailedRunIsANamedCheckNotALostCalibration) {
+  const auto dir = scratch("triaxial_failed");
+  const fs::path project = dir / "project";
+  fs::create_directories(project / "liggghts_inputs" / "materials");
+  fs::copy_file(fs::path(MILL_PROJECT_DIR) / "liggghts_inputs" / "materials" / "sandstone.yaml",
+                project / "liggghts_inputs" / "materials" / "sandstone.yaml");
+  spit(project / "liggghts_inputs" / "triaxial.in.tmpl", "no_such_command 1\n");
+  spit(dir / "case.yaml",
+       "name: triaxial_failed\nore: {card: sandstone}\n"
+       "resources: {np: 1, jobs: 1}\n");
+  setenv("MILL_LIGGGHTS", LIGGGHTS_MILL_EXE, 1);
+  const config::CaseConfig cfg = config::load_case(dir / "case.yaml", project);
+  RunOptions opts;
+  opts.output = dir;
+  engine::Runner runner;
+  std::ofstream progress_log(dir / "progress.log");
+  Progress progress(progress_log, false);
+  StageContext ctx{cfg, opts, dir, dir / "calibrate", runner, progress};
+  calibrate::Specimen sp;
+  sp.ball = dir / "ball.data";  // never read: the deck fails first
+  sp.mean_radius = 1e-3;
+  sp.cyl_r = 8e-3;
+  const calibrate::Targets targets{cfg.ore.real("youngs_modulus"), cfg.ore.real("poisson_ratio"),
+                                   cfg.ore.real("ucs"), cfg.ore.real("tensile_strength")};
+  calibrate::LabBench lab(ctx, "triaxial_failed", dir, sp, targets);
+  calibrate::UcsRun ucs;
+  ucs.r.ucs = 50e6;
+  const calibrate::Checks c = calibrate::run_checks(
+      lab, fixed_bonds(cfg), ucs, kStrainRate, {5e6, 10e6}, calibrate::CheckTargets{}, 0.0, 0.1, 1);
+  EXPECT_TRUE(c.triaxial.empty());
+  ASSERT_EQ(c.failed.size(), 2u);
+  EXPECT_NE(c.failed[0].find("triaxial_1 (runs/triaxial_1, confinement 5 MPa) failed"),
+            std::string::npos)
+      << c.failed[0];
+  EXPECT_NE(c.failed[1].find("ERROR"), std::string::npos) << c.failed[1];
+  EXPECT_EQ(c.failed[1].find('\n'), std::string::npos) << "one line: " << c.failed[1];
+  // The notes say so, and no envelope is made from one point.
+  ASSERT_GE(c.notes.size(), 2u);
+  EXPECT_EQ(c.notes[0], c.failed[0]);
+  EXPECT_FALSE(c.mc.has_value());
+  EXPECT_FALSE(c.envelope_error.empty());
 }
 
 }  // namespace

@@ -55,6 +55,23 @@ std::vector<double> confining_pressures(const config::Document& d, double ucs_re
   return p;
 }
 
+namespace {
+
+// An engine failure in one line: its first line and the engine's own ERROR
+// line from the log's tail (the run's folder keeps the whole log).
+std::string engine_error_gist(const std::string& what) {
+  std::istringstream in(what);
+  std::string first, line, error;
+  std::getline(in, first);
+  while (std::getline(in, line)) {
+    const auto at = line.find("ERROR");
+    if (at != std::string::npos && error.empty()) error = line.substr(at);
+  }
+  return error.empty() ? first : first + ": " + error;
+}
+
+}  // namespace
+
 // Triaxial runs, the envelope through their peaks and the UCS, then the SCB run.
 Checks run_checks(LabBench& lab, const BondParams& p, const UcsRun& ucs, double rate,
                   const std::vector<double>& pressures, const CheckTargets& targets, double done,
@@ -62,30 +79,40 @@ Checks run_checks(LabBench& lab, const BondParams& p, const UcsRun& ucs, double 
   Checks c;
   c.targets = targets;
   std::vector<post::StrengthPoint> points = {{0.0, ucs.r.ucs}};
-  // The triaxial tests side by side when the job has lanes for them.
-  c.triaxial.resize(pressures.size());
+  // The triaxial tests side by side when the job has lanes for them. A run
+  // that fails (its engine stopped: e.g. the energy ledger found energy
+  // created) is a failed check, named in the notes and left out of the
+  // envelope; the fit it checks stands (the report says which check did
+  // not run and why).
+  std::vector<std::optional<TriaxialRun>> runs(pressures.size());
+  std::vector<std::string> failed(pressures.size());
   std::vector<std::function<void()>> tasks;
   for (size_t k = 0; k < pressures.size(); ++k)
     tasks.push_back([&, k] {
       const std::string tag = fmt::format("triaxial_{}", k + 1);
       try {
-        c.triaxial[k] =
+        runs[k] =
             lab.triaxial(p, rate, pressures[k],
                          {tag, fmt::format("check: triaxial at {:.3g} MPa", pressures[k] / 1e6),
                           done + static_cast<double>(k) * step_share});
       } catch (const engine::Interrupted&) {
         throw;
       } catch (const std::exception& e) {
-        throw std::runtime_error(fmt::format("check {} (runs/{}, confinement {:.3g} MPa): {}",
-                                             tag, tag, pressures[k] / 1e6, e.what()));
+        failed[k] =
+            fmt::format("{} (runs/{}, confinement {:.3g} MPa) failed, left out of the envelope: {}",
+                        tag, tag, pressures[k] / 1e6, engine_error_gist(e.what()));
       }
     });
   run_concurrently(tasks, lab.lanes());
   for (size_t k = 0; k < pressures.size(); ++k) {
-    const std::string tag = fmt::format("triaxial_{}", k + 1);
-    const TriaxialRun& t = c.triaxial[k];
+    if (!runs[k]) {
+      c.notes.push_back(failed[k]);
+      c.failed.push_back(failed[k]);
+      continue;
+    }
+    const TriaxialRun& t = c.triaxial.emplace_back(std::move(*runs[k]));
     points.push_back({t.r.sigma3, t.r.sigma1});
-    if (!t.peaked) c.notes.push_back(tag + ": reached its strain cap still loading");
+    if (!t.peaked) c.notes.push_back(t.tag + ": reached its strain cap still loading");
   }
   try {
     c.mc = post::FitMohrCoulomb(points);
@@ -181,6 +208,7 @@ nlohmann::json checks_json(const Checks& c, double ucs_peak) {
       {"envelope", env},
       {"scb", scb},
       {"notes", c.notes},
+      {"failed", c.failed},
       {"against_card",
        {{"friction_angle",
          compared(c.targets.friction_angle_deg,

@@ -27,7 +27,8 @@ CheckTargets check_targets(const config::Document& ore);
 // What the checks measured.
 struct Checks {
   CheckTargets targets;
-  std::vector<TriaxialRun> triaxial;    // one per confining pressure, in the case's order
+  std::vector<TriaxialRun> triaxial;    // one per confining pressure that ran, in the case's order
+  std::vector<std::string> failed;      // the triaxial runs that failed, each with its reason
   std::optional<post::MohrCoulomb> mc;  // from the UCS and the triaxial peaks
   std::optional<post::HoekBrown> hb;    // from the same points
   std::string envelope_error;           // why an envelope could not be fitted, else ""

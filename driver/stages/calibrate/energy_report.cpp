@@ -35,26 +35,28 @@ nlohmann::json lab_energy_json(const post::LedgerSummary& e) {
           {"end_time_s", e.end_time_s}};
 }
 
-// Iterations in order, each UCS then Brazilian (then those of the fit's
-// further packings), the rate check, the packing
+// Iterations in order, each UCS then Brazilian then direct tension (then
+// those of the fit's further packings), the rate check, the packing
 // check's pairs, the levers' sensitivity pairs, then the checks.
 std::vector<const LabRun*> lab_runs(const Outcome& o) {
   std::vector<const LabRun*> runs;
+  // A packing's tests: UCS, Brazilian (with calibrate.tensile_test direct,
+  // on the kept parameters only: a run without a tag did not run), direct
+  // tension.
+  auto packing = [&](const UcsRun& ucs, const BrazilianRun& br,
+                     const std::optional<UcsRun>& tension) {
+    runs.push_back(&ucs);
+    if (!br.tag.empty()) runs.push_back(&br);
+    if (tension) runs.push_back(&*tension);
+  };
   for (const Iteration& it : o.hist) {
-    runs.push_back(&it.ucs);
-    runs.push_back(&it.br);
-    for (const PackingRun& p : it.more) {
-      runs.push_back(&p.ucs);
-      runs.push_back(&p.br);
-    }
+    packing(it.ucs, it.br, it.tension);
+    for (const PackingRun& p : it.more) packing(p.ucs, p.br, p.tension);
     if (it.scb)
       for (const ScbDisc& d : it.scb->discs) runs.push_back(&d);
   }
   if (o.half) runs.push_back(&*o.half);
-  for (const PackingRun& p : o.packings) {
-    runs.push_back(&p.ucs);
-    runs.push_back(&p.br);
-  }
+  for (const PackingRun& p : o.packings) packing(p.ucs, p.br, p.tension);
   for (const LeverRun& l : o.sensitivity) {
     runs.push_back(&l.ucs);
     runs.push_back(&l.br);

@@ -41,7 +41,8 @@ inline constexpr double kUcsWeightOutOfReach = 0.05;
 inline constexpr double kCoarseLeverGap = 1.2;
 
 // What the fit reads from an iteration: E, nu and the UCS of its UCS tests
-// and the tensile strength of its Brazilian tests, each the mean over the
+// and the tensile strength of its Brazilian tests (or, with
+// calibrate.tensile_test direct, of its direct tension tests), each the mean over the
 // fit's specimen packings (calibrate.fit_packings; with one, its own).
 struct Measured {
   double E = 0, nu = 0, ucs = 0, tensile = 0;
@@ -54,6 +55,7 @@ struct Iteration {
   BondParams p;
   UcsRun ucs;  // on the first packing (calibrate.seed's): its curves are the report's
   BrazilianRun br;
+  std::optional<UcsRun> tension;  // the direct tension test (calibrate.tensile_test direct)
   std::vector<PackingRun> more;  // on the fit's further packings (calibrate.fit_packings - 1)
   std::optional<ScbRun> scb;
   // The responses the fit aims at the ore card: the means over all packings.
@@ -66,6 +68,12 @@ struct Iteration {
   double score = 0;  // worst error in units of its tolerance
 };
 
+// The Brazilian strength of an iteration's discs, the mean over the fit's
+// packings; NaN when a disc did not split (post::kBrazilianSplitFraction).
+// With calibrate.tensile_test direct the discs run on the kept parameters
+// only, a check.
+double brazilian_mean(const Iteration& it);
+
 // The flat joint's local model's start: prior slopes J0, the range each
 // measured slope is kept in, the step cap per parameter (local_model.h).
 // Rows: ln E, nu, ln UCS, ln T, ln K_IC (the last used when the toughness is
@@ -77,7 +85,8 @@ struct LocalModelPrior {
   FitMat J0{}, lo{}, hi{};
   Vec4 max_step{};
 };
-LocalModelPrior flat_joint_prior();
+// direct: the tensile row of the direct tension test (calibrate.tensile_test).
+LocalModelPrior flat_joint_prior(bool direct = false);
 
 // Fits to the targets within relative tolerance tol (nu: kNuTolerance).
 class Fitting {

@@ -97,17 +97,35 @@ fs::path LabBench::run_test(const Test& test, const BondParams& p, double rate, 
   return work;
 }
 
-// A UCS test with bond parameters p at the given strain rate.
-UcsRun LabBench::ucs(const BondParams& p, double rate, const RunStep& step) {
-  UcsRun u;
-  const fs::path work = run_test({"ucs", sp_.cyl_r, t_.ucs / t_.E, 4.0}, p, rate, step, u);
-  u.curve = post::ReadLoadCurve((work / "ucs_curve.txt").string());
+namespace {
+
+// The cylinder's curve, size and analysis (the UCS and the direct tension
+// tests): what the deck <name>.in.tmpl wrote in `work`.
+void read_cylinder(UcsRun& u, const fs::path& work, const std::string& name) {
+  u.curve = post::ReadLoadCurve((work / (name + "_curve.txt")).string());
   const double D = info_at(u.info, "diameter", u.info_file);
   u.gauge = info_at(u.info, "gauge_length", u.info_file);
   u.area = M_PI * D * D / 4.0;
   u.ss = post::ToStressStrain(u.curve, u.gauge, u.area);
   u.r = post::AnalyseUcs(u.ss);
   u.peaked = u.r.peak_index + 1 < u.ss.stress.size();
+}
+
+}  // namespace
+
+// A UCS test with bond parameters p at the given strain rate.
+UcsRun LabBench::ucs(const BondParams& p, double rate, const RunStep& step) {
+  UcsRun u;
+  read_cylinder(u, run_test({"ucs", sp_.cyl_r, t_.ucs / t_.E, 4.0}, p, rate, step, u), "ucs");
+  return u;
+}
+
+// A direct tension test: the UCS cylinder pulled apart, its strain at the
+// peak about tensile / E (the target's), the cap eight times as far.
+UcsRun LabBench::tension(const BondParams& p, double rate, const RunStep& step) {
+  UcsRun u;
+  read_cylinder(u, run_test({"tension", sp_.cyl_r, t_.tensile / t_.E, 8.0}, p, rate, step, u),
+                "tension");
   return u;
 }
 
@@ -116,7 +134,7 @@ BrazilianRun LabBench::brazilian(const BondParams& p, double rate, const RunStep
   BrazilianRun b;
   // Closure/D at the peak is about 4 tensile / E.
   const fs::path work =
-      run_test({"brazilian", sp_.disc_r, 4.0 * t_.tensile / t_.E, 5.0}, p, rate, step, b);
+      run_test({"brazilian", sp_.disc_r, 4.0 * t_.disc_tensile() / t_.E, 5.0}, p, rate, step, b);
   b.curve = post::ReadLoadCurve((work / "brazilian_curve.txt").string());
   b.r = post::AnalyseBrazilian(b.curve, info_at(b.info, "diameter", b.info_file),
                                info_at(b.info, "thickness", b.info_file));
@@ -184,7 +202,7 @@ ScbRun LabBench::scb(const BondParams& p, double rate, int orientations, const R
         step.done};
     const fs::path work = run_test({"scb",
                                     kScbRadiusFactor * sp_.disc_r,
-                                    4.0 * t_.tensile / t_.E,
+                                    4.0 * t_.disc_tensile() / t_.E,
                                     10.0,
                                     {{"carve_angle", num(d.angle_deg)}}},
                                    p, rate, disc_step, d);

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -24,7 +25,15 @@ namespace mill::calibrate {
 
 // The ore card's macro properties: what the lab tests measure and the fit aims at.
 struct Targets {
+  // tensile: what the fit's tensile test aims at (lump/material.h,
+  // tensile_target): the card's Brazilian strength, or with `direct` its
+  // direct tensile strength.
   double E, nu, ucs, tensile;
+  bool direct =
+      false;  // the fit's tensile test is the direct tension test (calibrate.tensile_test)
+  double brazilian = 0;  // Pa, the card's (Brazilian) tensile strength; 0: `tensile`
+  // The Brazilian strength the disc tests expect (their strain scale).
+  double disc_tensile() const { return brazilian > 0 ? brazilian : tensile; }
   // Mode-I fracture toughness K_IC [Pa m^0.5] of the card when the fit aims
   // at it too (calibrate.fit_toughness, flat joints), 0 when not a target.
   double toughness = 0;
@@ -57,6 +66,9 @@ struct PackingRun {
   long seed = 0;  // the packing's first seed (Specimen::seed)
   UcsRun ucs;
   BrazilianRun br;
+  // The direct tension test (calibrate.tensile_test direct): the UCS
+  // cylinder pulled; its r.ucs is the direct tensile strength.
+  std::optional<UcsRun> tension;
 };
 
 struct TriaxialRun : LabRun {
@@ -125,6 +137,11 @@ class LabBench {
 
   // A UCS test with bond parameters p at the given strain rate.
   UcsRun ucs(const BondParams& p, double rate, const RunStep& step);
+  // A direct tension test (tension.in.tmpl: the UCS cylinder pulled apart by
+  // its end layers) with bond parameters p: its r.ucs is the direct tensile
+  // strength (the peak before failure), r.youngs_modulus the modulus in
+  // tension.
+  UcsRun tension(const BondParams& p, double rate, const RunStep& step);
   // A Brazilian test with bond parameters p at the given strain rate.
   BrazilianRun brazilian(const BondParams& p, double rate, const RunStep& step);
   // A triaxial test on the UCS cylinder under confining pressure `pressure` [Pa].

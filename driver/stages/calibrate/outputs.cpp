@@ -5,6 +5,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -30,12 +31,16 @@ nlohmann::json macro(const Iteration& it) {
                    {"ucs", a.ucs},
                    {"tensile_strength", a.tensile}};
   if (it.scb) m["fracture_toughness"] = it.scb->toughness;
+  // With the direct tension test as the tensile target: the model's
+  // Brazilian strength beside it (a check against the card's).
+  if (it.tension && !it.br.tag.empty()) m["brazilian_tensile_strength"] = brazilian_mean(it);
   return m;
 }
 
 // Wall seconds of an iteration's tests, every packing's and the bend test's.
 double iteration_seconds(const Iteration& it) {
-  return it.ucs.seconds + it.br.seconds + (it.scb ? it.scb->seconds : 0.0) + it.more_seconds();
+  return it.ucs.seconds + it.br.seconds + (it.tension ? it.tension->seconds : 0.0) +
+         (it.scb ? it.scb->seconds : 0.0) + it.more_seconds();
 }
 
 // A value of a run's info line, 0 when the deck did not write it.
@@ -223,9 +228,20 @@ nlohmann::json Report::json() const {
           {{"ucs", lab_energy_json(it.ucs.energy)}, {"brazilian", lab_energy_json(it.br.energy)}}},
          {"wall_seconds", iteration_seconds(it)}});
     if (t_.toughness > 0) iters.back()["errors"]["fracture_toughness"] = it.err_kic;
+    if (it.tension) {  // the direct tension test, the fit's tensile target
+      nlohmann::json& j = iters.back();
+      j["tension_peaked"] = it.tension->peaked;
+      j["energy"]["tension"] = lab_energy_json(it.tension->energy);
+      if (it.br.tag.empty())  // the discs ran on the kept parameters only
+        for (const char* k : {"brazilian_peak_force_N", "brazilian_peaked", "brazilian_split"})
+          j[k] = nullptr;
+      if (it.br.tag.empty()) j["energy"].erase("brazilian");
+    }
     if (!it.more.empty()) {  // the fit's packings, each (calibrate.fit_packings)
-      nlohmann::json each = nlohmann::json::array({packing_run_json(sp_.seed, it.ucs, it.br)});
-      for (const PackingRun& r : it.more) each.push_back(packing_run_json(r.seed, r.ucs, r.br));
+      nlohmann::json each =
+          nlohmann::json::array({packing_run_json(sp_.seed, it.ucs, it.br, it.tension)});
+      for (const PackingRun& r : it.more)
+        each.push_back(packing_run_json(r.seed, r.ucs, r.br, r.tension));
       iters.back()["packings"] = each;
     }
     if (it.scb) {  // the bend test of the toughness fit
@@ -270,6 +286,10 @@ nlohmann::json Report::json() const {
                            {"poisson_ratio", b_.err_nu <= kNuTolerance},
                            {"ucs", b_.err_ucs <= tol_},
                            {"tensile_strength", b_.err_t <= tol_}};
+  // Which test the tensile strength is (calibrate.tensile_test) and, with
+  // the direct one, the card's Brazilian strength it was converted from.
+  targets["tensile_test"] = t_.direct ? "direct" : "brazilian";
+  if (t_.direct) targets["brazilian_tensile_strength"] = t_.disc_tensile();
   if (t_.toughness > 0) {
     targets["fracture_toughness"] = t_.toughness;
     within["fracture_toughness"] = b_.err_kic <= tol_;
@@ -361,9 +381,15 @@ std::string Report::markdown() const {
                     kNuTolerance, b_.err_nu <= kNuTolerance ? "yes" : "no");
   md << fmt::format("| UCS (MPa) | {:.1f} | {:.1f} | {:.1f}% | {:.0f}% | {} |\n", t_.ucs / 1e6,
                     bm_.ucs / 1e6, 100 * b_.err_ucs, 100 * tol_, b_.err_ucs <= tol_ ? "yes" : "no");
-  md << fmt::format("| tensile (MPa) | {:.2f} | {:.2f} | {:.1f}% | {:.0f}% | {} |\n",
-                    t_.tensile / 1e6, bm_.tensile / 1e6, 100 * b_.err_t, 100 * tol_,
-                    b_.err_t <= tol_ ? "yes" : "no");
+  md << fmt::format("| {} (MPa) | {:.2f} | {:.2f} | {:.1f}% | {:.0f}% | {} |\n",
+                    t_.direct ? "direct tensile" : "tensile", t_.tensile / 1e6, bm_.tensile / 1e6,
+                    100 * b_.err_t, 100 * tol_, b_.err_t <= tol_ ? "yes" : "no");
+  if (t_.direct && b_.tension)
+    md << fmt::format(
+        "| Brazilian tensile (MPa; the card's, not fitted) | {:.2f} | {:.2f} | {:.1f}% | - | "
+        "check |\n",
+        t_.disc_tensile() / 1e6, brazilian_mean(b_) / 1e6,
+        100 * post::RelativeError(brazilian_mean(b_), t_.disc_tensile()));
   if (t_.toughness > 0 && b_.scb)
     md << fmt::format(
         "| K_IC (MPa m^0.5; semi-circular bend, mean of {} half discs +- its standard error) | "
@@ -372,6 +398,13 @@ std::string Report::markdown() const {
         b_.scb->toughness_sem / 1e6, 100 * b_.err_kic, 100 * tol_,
         b_.err_kic <= tol_ ? "yes" : "no");
   md << "\n";
+  if (t_.direct)
+    md << fmt::format(
+        "The tensile target is the direct tension test's (calibrate.tensile_test direct: the UCS "
+        "cylinder pulled apart by its end layers): {:.2f} MPa, from the card's Brazilian {:.2f} "
+        "MPa (x {:.2f}: its direct_tensile_strength, or rock_class by Perras & Diederichs 2014). "
+        "The Brazilian test still runs; its strength is a check.\n\n",
+        t_.tensile / 1e6, t_.disc_tensile() / 1e6, t_.tensile / t_.disc_tensile());
   md << "## Bond parameters (calibrated.yaml)\n\n| parameter | value |\n|---|---|\n";
   md << fmt::format(
       "| bond model (lump.bond_model) | {} |\n| bond modulus (GPa) | {:.3f} |\n| kn/ks | {:.3f} "
@@ -465,6 +498,9 @@ std::string Report::curves() const {
     }
     append_curves(cv, fmt::format("it{}_brazilian", i + 1), static_cast<int>(i + 1), "brazilian",
                   rate_, it.br.curve, strain, stress);
+    if (it.tension)
+      append_curves(cv, fmt::format("it{}_tension", i + 1), static_cast<int>(i + 1), "tension",
+                    rate_, it.tension->curve, it.tension->ss.strain, it.tension->ss.stress);
   }
   if (half_)
     append_curves(cv, "rate_check_ucs", static_cast<int>(best_ + 1), "ucs", 0.5 * rate_,

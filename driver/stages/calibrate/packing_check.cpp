@@ -67,6 +67,7 @@ std::vector<PackingRun> run_packings(StageContext& ctx, const std::string& job_l
     lab.set_lanes(lanes);
     const double at = done + 2.0 * (k - 1) * step_share;
     const std::string of = fmt::format("packing check {}/{}", k, packings);
+    // The fit's tests: UCS and its tensile test (calibrate.tensile_test).
     run_concurrently(
         {[&] {
            r.ucs = lab.ucs(p, rate,
@@ -74,10 +75,16 @@ std::vector<PackingRun> run_packings(StageContext& ctx, const std::string& job_l
                             fmt::format("{}: UCS (seed {})", of, r.seed), at});
          },
          [&] {
-           r.br = lab.brazilian(p, rate,
-                                {fmt::format("packing{}_brazilian", k),
-                                 fmt::format("{}: Brazilian (seed {})", of, r.seed),
-                                 at + step_share});
+           if (t.direct)
+             r.tension = lab.tension(
+                 p, rate,
+                 {fmt::format("packing{}_tension", k),
+                  fmt::format("{}: direct tension (seed {})", of, r.seed), at + step_share});
+           else
+             r.br = lab.brazilian(
+                 p, rate,
+                 {fmt::format("packing{}_brazilian", k),
+                  fmt::format("{}: Brazilian (seed {})", of, r.seed), at + step_share});
          }},
         lab.lanes());
     runs.push_back(std::move(r));
@@ -92,8 +99,13 @@ PackingSpread packing_spread(const Iteration& best, long seed, const std::vector
   PackingSpread s;
   s.seeds.push_back(seed);
   s.fit_packings = 1 + best.more.size();
+  // The tensile strength of the fit's test: the direct tension test's when
+  // it ran (calibrate.tensile_test direct), else the Brazilian disc's.
+  auto tensile = [](const BrazilianRun& br, const std::optional<UcsRun>& tension) {
+    return tension ? tension->r.ucs : br.r.tensile_strength;
+  };
   std::vector<double> e{best.ucs.r.youngs_modulus}, nu{best.ucs.r.poisson_ratio},
-      ucs{best.ucs.r.ucs}, t{best.br.r.tensile_strength};
+      ucs{best.ucs.r.ucs}, t{tensile(best.br, best.tension)};
   // The fit's further packings, then the check's (no copies of their curves).
   for (const std::vector<PackingRun>* group : {&best.more, &runs})
     for (const PackingRun& r : *group) {
@@ -101,7 +113,7 @@ PackingSpread packing_spread(const Iteration& best, long seed, const std::vector
       e.push_back(r.ucs.r.youngs_modulus);
       nu.push_back(r.ucs.r.poisson_ratio);
       ucs.push_back(r.ucs.r.ucs);
-      t.push_back(r.br.r.tensile_strength);
+      t.push_back(tensile(r.br, r.tension));
     }
   s.E = property(std::move(e), tol, false);
   s.nu = property(std::move(nu), nu_tol, true);
@@ -110,16 +122,29 @@ PackingSpread packing_spread(const Iteration& best, long seed, const std::vector
   return s;
 }
 
-nlohmann::json packing_run_json(long seed, const UcsRun& ucs, const BrazilianRun& br) {
-  return {{"seed", seed},
-          {"youngs_modulus", ucs.r.youngs_modulus},
-          {"poisson_ratio", ucs.r.poisson_ratio},
-          {"ucs", ucs.r.ucs},
-          {"tensile_strength", br.r.tensile_strength},
-          {"ucs_run", ucs.tag},
-          {"brazilian_run", br.tag},
-          {"energy",
-           {{"ucs", lab_energy_json(ucs.energy)}, {"brazilian", lab_energy_json(br.energy)}}}};
+nlohmann::json packing_run_json(long seed, const UcsRun& ucs, const BrazilianRun& br,
+                                const std::optional<UcsRun>& tension) {
+  nlohmann::json j = {
+      {"seed", seed},
+      {"youngs_modulus", ucs.r.youngs_modulus},
+      {"poisson_ratio", ucs.r.poisson_ratio},
+      {"ucs", ucs.r.ucs},
+      {"tensile_strength", br.r.tensile_strength},
+      {"ucs_run", ucs.tag},
+      {"brazilian_run", br.tag},
+      {"energy",
+       {{"ucs", lab_energy_json(ucs.energy)}, {"brazilian", lab_energy_json(br.energy)}}}};
+  if (tension) {  // calibrate.tensile_test direct: the fit's tensile strength
+    j["direct_tensile_strength"] = tension->r.ucs;
+    j["tension_run"] = tension->tag;
+    j["energy"]["tension"] = lab_energy_json(tension->energy);
+    if (br.tag.empty()) {  // the discs ran on the kept parameters only
+      j["tensile_strength"] = nullptr;
+      j["brazilian_run"] = nullptr;
+      j["energy"].erase("brazilian");
+    }
+  }
+  return j;
 }
 
 nlohmann::json packing_json(const PackingSpread& s, const std::vector<PackingRun>& runs) {
@@ -132,8 +157,8 @@ nlohmann::json packing_json(const PackingSpread& s, const std::vector<PackingRun
   double seconds = 0;
   nlohmann::json each = nlohmann::json::array();
   for (const PackingRun& r : runs) {
-    seconds += r.ucs.seconds + r.br.seconds;
-    each.push_back(packing_run_json(r.seed, r.ucs, r.br));
+    seconds += r.ucs.seconds + r.br.seconds + (r.tension ? r.tension->seconds : 0.0);
+    each.push_back(packing_run_json(r.seed, r.ucs, r.br, r.tension));
   }
   j["wall_seconds"] = seconds;
   j["runs"] = each;

@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -56,8 +57,10 @@ PackingSpread packing_spread(const Iteration& best, long seed, const std::vector
                              double tol, double nu_tol);
 
 // One packing's runs in report.json: its seed, E, nu, UCS and tensile
-// strength, the runs' folders and energy ledgers.
-nlohmann::json packing_run_json(long seed, const UcsRun& ucs, const BrazilianRun& br);
+// strength, the runs' folders and energy ledgers; with the direct tension
+// test (calibrate.tensile_test direct) its strength and run too.
+nlohmann::json packing_run_json(long seed, const UcsRun& ucs, const BrazilianRun& br,
+                                const std::optional<UcsRun>& tension = std::nullopt);
 
 // report.json's "packing_check": the spread, and each further packing's runs
 // with their energy ledgers.
