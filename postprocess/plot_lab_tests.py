@@ -107,12 +107,41 @@ def plot_brazilian(runs, report, out):
             ax.annotate(f"peak {f[k]:.2f} kN, sigma_t {st[k] / 1e6:.2f} MPa", (d[k], f[k]),
                         textcoords="offset points", xytext=(-200, 8))
 
+    t = report["targets"]
+    # With the direct tension test as the tensile target the disc is a check
+    # against the card's Brazilian strength (calibrate.tensile_test direct).
+    direct = t.get("tensile_test") == "direct"
+    target = (f"card {t['brazilian_tensile_strength'] / 1e6:.1f} MPa, a check" if direct
+              else f"target {t['tensile_strength'] / 1e6:.1f} MPa")
     plot_test_curves(runs, report, out, "brazilian",
                      x=("displacement_m", lambda x: 1e6 * x), y=("force_N", lambda x: x / 1e3), mark=mark,
                      xlabel="jaw closure (um)", ylabel="load (kN)",
-                     title=f"Brazilian tests, {report['ore']} "
-                           f"(target {report['targets']['tensile_strength'] / 1e6:.1f} MPa)",
+                     title=f"Brazilian tests, {report['ore']} ({target})",
                      filename="brazilian_load_displacement.png")
+
+
+def plot_tension(runs, report, out):
+    """Stress-strain of every direct tension run (calibrate.tensile_test
+    direct), peaks marked; nothing when none ran."""
+    if not any(run["test"] == "tension" for run in runs.values()):
+        return
+
+    def mark(ax, run, strain, stress, is_best):
+        k = max(range(len(stress)), key=lambda i: stress[i])
+        ax.plot(strain[k], stress[k], "ko" if is_best else "k.")
+        if is_best:
+            ax.annotate(f"peak {stress[k]:.2f} MPa", (strain[k], stress[k]), textcoords="offset points",
+                        xytext=(-60, 10))
+
+    def decorate(ax):
+        t = report["targets"]["tensile_strength"]
+        ax.axhline(t / 1e6, color="grey", lw=0.8, ls="-.", label=f"target {t / 1e6:.2f} MPa")
+
+    plot_test_curves(runs, report, out, "tension",
+                     x=("strain", lambda e: 1e3 * e), y=("stress_Pa", lambda s: s / 1e6), mark=mark,
+                     xlabel="axial strain (1e-3)", ylabel="tensile stress (MPa)",
+                     title=f"Direct tension tests, {report['ore']}", filename="tension_stress_strain.png",
+                     decorate=decorate)
 
 
 def plot_convergence(report, out):
@@ -123,7 +152,7 @@ def plot_convergence(report, out):
     its = [i["iteration"] for i in report["iterations"]]
     fig, ax = plt.subplots(figsize=(7, 4))
     props = [("youngs_modulus", "E"), ("poisson_ratio", "nu"), ("ucs", "UCS"),
-             ("tensile_strength", "tensile")]
+             ("tensile_strength", "direct tensile" if t.get("tensile_test") == "direct" else "tensile")]
     if "fracture_toughness" in t:
         props.append(("fracture_toughness", "K_IC"))
     for key, name in props:
@@ -154,6 +183,7 @@ def main():
     runs = read_curves(a.curves)
     plot_ucs(runs, report, a.out)
     plot_brazilian(runs, report, a.out)
+    plot_tension(runs, report, a.out)
     plot_convergence(report, a.out)
 
 

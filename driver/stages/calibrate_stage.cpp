@@ -196,8 +196,8 @@ void Calibration::run() {
     Iteration it;
     it.p = p;
     it.more.resize(more.size());
-    // The UCS and the Brazilian test of every packing, side by side as the
-    // job's lanes allow.
+    // The UCS and the tensile test (Brazilian, or direct tension) of every
+    // packing, side by side as the job's lanes allow.
     const double at = per_it * (k - 1);
     std::vector<std::function<void()>> tests = {[&] {
       it.ucs = lab.ucs(p, rate_,

@@ -12,7 +12,8 @@ class CalibrateStage : public Stage {
  public:
   std::string name() const override { return "calibrate"; }
   std::string description() const override {
-    return "fit bond parameters to the ore card (virtual UCS and Brazilian tests)";
+    return "fit bond parameters to the ore card (virtual UCS and Brazilian or direct tension "
+           "tests)";
   }
   Plan plan(const StageContext& ctx) const override;
   void run_job(StageContext& ctx, const JobSpec& job,
