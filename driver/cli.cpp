@@ -515,6 +515,15 @@ int cli_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
       out << fmt::format(
           "calibration key of this ore card and lump: input_hash {} (fitted_for: {})\n",
           calibration_hash(cfg), scale);
+      // The tensile strength the calibration aims at (calibrate.tensile_test).
+      if (fits_direct_tension(cfg))
+        out << fmt::format(
+            "tensile target: direct tension, {:g} MPa ({})\n", tensile_target(cfg) / 1e6,
+            cfg.ore.has("direct_tensile_strength")
+                ? std::string("the card's direct_tensile_strength")
+                : fmt::format("{:g} x the card's Brazilian {:g} MPa, rock_class {}",
+                              direct_over_brazilian(cfg.ore),
+                              cfg.ore.real("tensile_strength") / 1e6, cfg.ore.str("rock_class")));
       return 0;
     }
     return stage_command(cfg, a, command, out, err);

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <functional>
 #include <utility>
@@ -320,10 +321,25 @@ void Calibration::run() {
              (per_it * max_it_ + static_cast<double>(j + 1)) / steps_total});
       });
     run_concurrently(discs, lab.lanes());
-    ctx_.progress.info(fmt::format(
-        "[calibrate] check: the kept parameters' Brazilian strength {:.2f} MPa (the card's {:.2f} "
-        "MPa; not fitted: the direct tension test is the tensile target)",
-        brazilian_mean(b) / 1e6, t.disc_tensile() / 1e6));
+    // Each disc's strength, "no split" for a crushed one (its largest load
+    // then is no tensile strength: post::kBrazilianSplitFraction).
+    auto disc = [](const BrazilianRun& r) {
+      return r.r.no_split ? fmt::format("no split ({:.0f}% of the bonds lost, {:.2f} MPa at most)",
+                                        100 * r.r.bonds_lost, r.r.tensile_strength / 1e6)
+                          : fmt::format("{:.2f}", r.r.tensile_strength / 1e6);
+    };
+    std::string each = disc(b.br);
+    for (const PackingRun& r : b.more) each += ", " + disc(r.br);
+    const double mean = brazilian_mean(b);
+    const std::string text = fmt::format(
+        "check: the kept parameters' Brazilian discs {} MPa{} (the card's {:.2f} MPa; not "
+        "fitted: the direct tension test is the tensile target)",
+        each,
+        std::isfinite(mean) ? fmt::format(", mean {:.2f}", mean / 1e6)
+                            : std::string(", no mean: a disc did not split"),
+        t.disc_tensile() / 1e6);
+    notes.push_back(text);
+    ctx_.progress.info("[calibrate] " + text);
   }
   // Rate check: the best parameters at half the strain rate.
   if (rate_check)

@@ -384,12 +384,18 @@ std::string Report::markdown() const {
   md << fmt::format("| {} (MPa) | {:.2f} | {:.2f} | {:.1f}% | {:.0f}% | {} |\n",
                     t_.direct ? "direct tensile" : "tensile", t_.tensile / 1e6, bm_.tensile / 1e6,
                     100 * b_.err_t, 100 * tol_, b_.err_t <= tol_ ? "yes" : "no");
-  if (t_.direct && b_.tension)
-    md << fmt::format(
-        "| Brazilian tensile (MPa; the card's, not fitted) | {:.2f} | {:.2f} | {:.1f}% | - | "
-        "check |\n",
-        t_.disc_tensile() / 1e6, brazilian_mean(b_) / 1e6,
-        100 * post::RelativeError(brazilian_mean(b_), t_.disc_tensile()));
+  if (t_.direct && b_.tension) {
+    const double disc = brazilian_mean(b_);
+    md << (std::isfinite(disc)
+               ? fmt::format(
+                     "| Brazilian tensile (MPa; the card's, not fitted) | {:.2f} | {:.2f} | "
+                     "{:.1f}% | - | check |\n",
+                     t_.disc_tensile() / 1e6, disc / 1e6,
+                     100 * post::RelativeError(disc, t_.disc_tensile()))
+               : fmt::format("| Brazilian tensile (MPa; the card's, not fitted) | {:.2f} | a disc "
+                             "did not split (notes) | - | - | check |\n",
+                             t_.disc_tensile() / 1e6));
+  }
   if (t_.toughness > 0 && b_.scb)
     md << fmt::format(
         "| K_IC (MPa m^0.5; semi-circular bend, mean of {} half discs +- its standard error) | "
