@@ -357,6 +357,74 @@ TEST_F(TinyCalibration, FitOnTwoPackingsAimsTheirMeansAtTheCard) {
           "calibrate.fit_packings"));
 }
 
+// calibrate.tensile_test direct: each iteration runs the UCS and the direct
+// tension test (the pulled cylinder) on every fit packing and the fit reads
+// the latter's mean, aimed at the card's Brazilian strength x 0.7 (the
+// sandstone is sedimentary); the Brazilian discs run once, on the kept
+// parameters, and are reported as a check; the packing check pulls its
+// cylinder too; every run's ledger is counted, the tension plot drawn; the
+// job's inputs carry the target, the Brazilian fixture's do not.
+TEST_F(TinyCalibration, DirectTensionFitReadsThePulledCylindersAndChecksTheDiscs) {
+  ASSERT_EQ(status_, 0) << slurp(*dir_ / "first.log");
+  const auto dir = scratch("tiny_direct");
+  spit(dir / "case.yaml",
+       "name: tiny_direct\nore: {card: sandstone}\nlump: {n_elements: 150, diameter: 0.02, "
+       "bond_gap: 0.2}\ncalibrate: {n_elements: 200, max_iterations: 1, strain_rate: 2.0, seed: "
+       "2003, fit_packings: 2, packing_check: 1, rate_check: false, sensitivity: false, "
+       "confining_pressures: [0.1], scb_orientations: 1, tensile_test: direct}\n"
+       "resources: {np: 1, jobs: 2}\n");
+  ASSERT_EQ(orchestrate("--case " + (dir / "case.yaml").string() + " --stage calibrate --output " +
+                            dir.string(),
+                        dir / "log"),
+            0)
+      << slurp(dir / "log");
+  const fs::path job = dir / "calibrate" / "jobs" / "calibration";
+  const auto r = read_json(job / "report.json");
+  EXPECT_EQ(r["targets"]["tensile_test"], "direct");
+  EXPECT_NEAR(r["targets"]["tensile_strength"].get<double>(), 3.5e6, 1e-3);
+  EXPECT_NEAR(r["targets"]["brazilian_tensile_strength"].get<double>(), 5e6, 1e-3);
+  const auto& it = r["iterations"][0];
+  const auto& packings = it["packings"];
+  ASSERT_EQ(packings.size(), 2u) << it.dump(1);
+  const double a = packings[0]["direct_tensile_strength"].get<double>(),
+               b = packings[1]["direct_tensile_strength"].get<double>();
+  EXPECT_GT(a, 0.0);
+  EXPECT_NE(a, b);
+  EXPECT_NEAR(it["achieved"]["tensile_strength"].get<double>(), 0.5 * (a + b), 1e-12 * (a + b));
+  EXPECT_NEAR(it["errors"]["tensile_strength"].get<double>(),
+              std::abs(0.5 * (a + b) - 3.5e6) / 3.5e6, 1e-9);
+  // The discs: on the kept parameters (here iteration 1) only, as a check.
+  for (const char* run : {"it1_tension", "it1_p2_tension", "check_brazilian", "check_p2_brazilian",
+                          "packing1_tension"})
+    EXPECT_TRUE(fs::exists(job / "runs" / run / "ledger.csv")) << run;
+  for (const char* run : {"it1_brazilian", "it1_p2_brazilian", "packing1_brazilian"})
+    EXPECT_FALSE(fs::exists(job / "runs" / run)) << run;
+  EXPECT_TRUE(it["achieved"].contains("brazilian_tensile_strength")) << it["achieved"].dump();
+  EXPECT_EQ(packings[1]["brazilian_run"], "check_p2_brazilian");
+  // The packing check's spread reads the direct test: its third value is
+  // the check packing's pulled cylinder.
+  const auto& pc = r["packing_check"];
+  ASSERT_EQ(pc["runs"].size(), 1u) << pc.dump(1);
+  EXPECT_EQ(pc["tensile_strength"]["values"][0], packings[0]["direct_tensile_strength"]);
+  EXPECT_EQ(pc["tensile_strength"]["values"][2], pc["runs"][0]["direct_tensile_strength"]);
+  // Every run's ledger: 2 UCS + 2 pulled cylinders + 2 check discs, the
+  // packing check's 2, 1 triaxial, 1 half disc.
+  EXPECT_EQ(r["energy"]["lab_runs"].get<int>(), 10) << r["energy"].dump();
+  EXPECT_TRUE(fs::exists(job / "plots" / "tension_stress_strain.png"));
+  const std::string md = slurp(job / "report.md");
+  EXPECT_NE(md.find("| direct tensile (MPa) | 3.50 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| Brazilian tensile (MPa; the card's, not fitted) | 5.00 |"),
+            std::string::npos)
+      << md;
+  const auto inputs = read_json(job / "job.json")["inputs"];
+  EXPECT_EQ(inputs["calibrate.tensile_test"], "direct");
+  EXPECT_NEAR(inputs["direct_tensile_strength"].get<double>(), 3.5e6, 1e-3);
+  const auto fixture =
+      read_json(*dir_ / "calibrate" / "jobs" / "calibration" / "job.json")["inputs"];
+  EXPECT_FALSE(fixture.contains("calibrate.tensile_test"));
+  EXPECT_FALSE(fixture.contains("direct_tensile_strength"));
+}
+
 // A card whose calibrated.* section does not match its properties (stale
 // input_hash): the fit starts from that section. Used here to start from
 // chosen parameters.
