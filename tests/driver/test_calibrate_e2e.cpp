@@ -296,6 +296,22 @@ TEST_F(TinyCalibration, TwoLanesGiveTheSameCalibrationWithTestsSideBySide) {
   EXPECT_LT(started("it1_brazilian", "brazilian_info.txt"), started("it1_ucs", "liggghts.log"));
 }
 
+// The tiny calibration fitted on two packings with a packing check of one,
+// one triaxial confinement and one half disc (`extra`: more calibrate keys,
+// ", key: value"), run in `dir` (its log: dir/log); the exit status.
+int run_two_packings(const fs::path& dir, const std::string& name, const std::string& extra) {
+  spit(dir / "case.yaml",
+       "name: " + name +
+           "\nore: {card: sandstone}\nlump: {n_elements: 150, diameter: 0.02, bond_gap: 0.2}\n"
+           "calibrate: {n_elements: 200, max_iterations: 1, strain_rate: 2.0, seed: 2003, "
+           "fit_packings: 2, packing_check: 1, rate_check: false, sensitivity: false, "
+           "confining_pressures: [0.1], scb_orientations: 1" +
+           extra + "}\nresources: {np: 1, jobs: 2}\n");
+  return orchestrate(
+      "--case " + (dir / "case.yaml").string() + " --stage calibrate --output " + dir.string(),
+      dir / "log");
+}
+
 // calibrate.fit_packings 2: every iteration tests two packings and the fit
 // reads their means (the achieved properties are the arithmetic means of
 // the two packings' to the last digit); the packing check's table starts
@@ -304,16 +320,7 @@ TEST_F(TinyCalibration, TwoLanesGiveTheSameCalibrationWithTestsSideBySide) {
 TEST_F(TinyCalibration, FitOnTwoPackingsAimsTheirMeansAtTheCard) {
   ASSERT_EQ(status_, 0) << slurp(*dir_ / "first.log");
   const auto dir = scratch("tiny_fit_packings");
-  spit(dir / "case.yaml",
-       "name: tiny_fit_packings\nore: {card: sandstone}\nlump: {n_elements: 150, diameter: 0.02, "
-       "bond_gap: 0.2}\ncalibrate: {n_elements: 200, max_iterations: 1, strain_rate: 2.0, seed: "
-       "2003, fit_packings: 2, packing_check: 1, rate_check: false, sensitivity: false, "
-       "confining_pressures: [0.1], scb_orientations: 1}\nresources: {np: 1, jobs: 2}\n");
-  ASSERT_EQ(orchestrate("--case " + (dir / "case.yaml").string() + " --stage calibrate --output " +
-                            dir.string(),
-                        dir / "log"),
-            0)
-      << slurp(dir / "log");
+  ASSERT_EQ(run_two_packings(dir, "tiny_fit_packings", ""), 0) << slurp(dir / "log");
   const fs::path job = dir / "calibrate" / "jobs" / "calibration";
   const auto r = read_json(job / "report.json");
   const auto& packings = r["iterations"][0]["packings"];
@@ -367,16 +374,7 @@ TEST_F(TinyCalibration, FitOnTwoPackingsAimsTheirMeansAtTheCard) {
 TEST_F(TinyCalibration, DirectTensionFitReadsThePulledCylindersAndChecksTheDiscs) {
   ASSERT_EQ(status_, 0) << slurp(*dir_ / "first.log");
   const auto dir = scratch("tiny_direct");
-  spit(dir / "case.yaml",
-       "name: tiny_direct\nore: {card: sandstone}\nlump: {n_elements: 150, diameter: 0.02, "
-       "bond_gap: 0.2}\ncalibrate: {n_elements: 200, max_iterations: 1, strain_rate: 2.0, seed: "
-       "2003, fit_packings: 2, packing_check: 1, rate_check: false, sensitivity: false, "
-       "confining_pressures: [0.1], scb_orientations: 1, tensile_test: direct}\n"
-       "resources: {np: 1, jobs: 2}\n");
-  ASSERT_EQ(orchestrate("--case " + (dir / "case.yaml").string() + " --stage calibrate --output " +
-                            dir.string(),
-                        dir / "log"),
-            0)
+  ASSERT_EQ(run_two_packings(dir, "tiny_direct", ", tensile_test: direct"), 0)
       << slurp(dir / "log");
   const fs::path job = dir / "calibrate" / "jobs" / "calibration";
   const auto r = read_json(job / "report.json");

@@ -14,20 +14,17 @@
 //   (a deck that ignored `pull` would measure the UCS again).
 #include <fmt/format.h>
 #include <gtest/gtest.h>
-#include <stdlib.h>
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <iostream>
 #include <string>
 
 #include "config/case_config.h"
 #include "e2e_util.h"
-#include "engine/runner.h"
+#include "lab_context.h"
 #include "lump/material.h"
 #include "postprocess/lab_tests.h"
-#include "progress.h"
 #include "stages/calibrate/lab_runs.h"
 #include "stages/calibrate/specimen.h"
 #include "stages/stage.h"
@@ -67,16 +64,11 @@ TEST(DirectTension, GripsInEquilibriumStrengthScalesWithTheBondsAndBelowTheUcs) 
            "calibrate: {{n_elements: {}, strain_rate: {}, seed: 2003, tensile_test: direct}}\n"
            "resources: {{np: 1, jobs: 1}}\n",
            kElements, kStrainRate));
-  setenv("MILL_LIGGGHTS", LIGGGHTS_MILL_EXE, 1);
-  const config::CaseConfig cfg = config::load_case(dir / "case.yaml", MILL_PROJECT_DIR);
+  test::LabContext lab_ctx(dir, MILL_PROJECT_DIR);
+  const config::CaseConfig& cfg = lab_ctx.cfg;
+  StageContext& ctx = lab_ctx.ctx;
   // The sandstone card's direct tensile strength: 0.7 x 5 MPa (sedimentary).
   ASSERT_NEAR(tensile_target(cfg), 3.5e6, 1.0);
-  RunOptions opts;
-  opts.output = dir;
-  engine::Runner runner;
-  std::ofstream progress_log(dir / "progress.log");
-  Progress progress(progress_log, false);
-  StageContext ctx{cfg, opts, dir, dir / "calibrate", runner, progress};
 
   const calibrate::Specimen sp = calibrate::pack_specimen(ctx, "tension", dir, kElements);
   calibrate::Targets targets{cfg.ore.real("youngs_modulus"), cfg.ore.real("poisson_ratio"),

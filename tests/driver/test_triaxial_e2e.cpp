@@ -20,6 +20,7 @@
 #include "config/case_config.h"
 #include "e2e_util.h"
 #include "engine/runner.h"
+#include "lab_context.h"
 #include "lump/material.h"
 #include "postprocess/lab_tests.h"
 #include "progress.h"
@@ -76,14 +77,9 @@ TEST(TriaxialEnvelope, MiddlePeakLiesOnTheMohrCoulombLineOfTheOuterConfinements)
                                       "calibrate: {{n_elements: {}, strain_rate: {}, seed: 2003}}\n"
                                       "resources: {{np: 1, jobs: 1}}\n",
                                       kElements, kStrainRate));
-  setenv("MILL_LIGGGHTS", LIGGGHTS_MILL_EXE, 1);
-  const config::CaseConfig cfg = config::load_case(dir / "case.yaml", MILL_PROJECT_DIR);
-  RunOptions opts;
-  opts.output = dir;
-  engine::Runner runner;
-  std::ofstream progress_log(dir / "progress.log");
-  Progress progress(progress_log, false);
-  StageContext ctx{cfg, opts, dir, dir / "calibrate", runner, progress};
+  test::LabContext lab_ctx(dir, MILL_PROJECT_DIR);
+  const config::CaseConfig& cfg = lab_ctx.cfg;
+  StageContext& ctx = lab_ctx.ctx;
 
   const calibrate::Specimen sp = calibrate::pack_specimen(ctx, "triaxial", dir, kElements);
   // The targets only size each run (its strain cap and sampling interval);
@@ -175,14 +171,9 @@ TEST(TriaxialCheck, FailedRunIsANamedCheckNotALostCalibration) {
   spit(dir / "case.yaml",
        "name: triaxial_failed\nore: {card: sandstone}\n"
        "resources: {np: 1, jobs: 1}\n");
-  setenv("MILL_LIGGGHTS", LIGGGHTS_MILL_EXE, 1);
-  const config::CaseConfig cfg = config::load_case(dir / "case.yaml", project);
-  RunOptions opts;
-  opts.output = dir;
-  engine::Runner runner;
-  std::ofstream progress_log(dir / "progress.log");
-  Progress progress(progress_log, false);
-  StageContext ctx{cfg, opts, dir, dir / "calibrate", runner, progress};
+  test::LabContext lab_ctx(dir, project);
+  const config::CaseConfig& cfg = lab_ctx.cfg;
+  StageContext& ctx = lab_ctx.ctx;
   calibrate::Specimen sp;
   sp.ball = dir / "ball.data";  // never read: the deck fails first
   sp.mean_radius = 1e-3;

@@ -232,10 +232,11 @@ nlohmann::json Report::json() const {
       nlohmann::json& j = iters.back();
       j["tension_peaked"] = it.tension->peaked;
       j["energy"]["tension"] = lab_energy_json(it.tension->energy);
-      if (it.br.tag.empty())  // the discs ran on the kept parameters only
+      if (it.br.tag.empty()) {  // the discs ran on the kept parameters only
         for (const char* k : {"brazilian_peak_force_N", "brazilian_peaked", "brazilian_split"})
           j[k] = nullptr;
-      if (it.br.tag.empty()) j["energy"].erase("brazilian");
+        j["energy"].erase("brazilian");
+      }
     }
     if (!it.more.empty()) {  // the fit's packings, each (calibrate.fit_packings)
       nlohmann::json each =
