@@ -18,9 +18,11 @@ namespace {
 // The ore card's key of a name in its calibrated: section.
 std::string card_key(const char* name) { return std::string(kCalibratedSection) + "." + name; }
 
-// A row the model uses (a flat joint has no parallel-bond rows).
+// A row the model uses (a flat joint has no parallel-bond rows, a parallel
+// bond no flat-joint rows).
 bool uses(const BondParams& b, const BondParameter& p) {
-  return !(p.parallel_only && b.model == BondModel::flat_joint);
+  return !(p.parallel_only && b.model == BondModel::flat_joint) &&
+         !(p.joint_only && b.model != BondModel::flat_joint);
 }
 
 // `base` with the model, its layout and each fitted row set from `find`
@@ -57,6 +59,10 @@ BondParams read_fitted(const std::function<std::optional<double>(const char*)>& 
 
 }  // namespace
 
+bool bond_row_shown(const BondParams& b, const BondParameter& p) {
+  return uses(b, p) && !(p.joint_only && b.*p.value == p.start);
+}
+
 const char* bond_model_name(BondModel m) {
   return m == BondModel::flat_joint ? "flat_joint" : "parallel";
 }
@@ -84,7 +90,7 @@ nlohmann::json bond_json(const BondParams& b, BondNames names) {
     j[card ? card_key(kSectorsKey) : kSectorsKey] = b.joint_sectors;
   }
   for (const BondParameter& p : kBondParameters) {
-    if (!uses(b, p)) continue;
+    if (!bond_row_shown(b, p)) continue;
     if (names == BondNames::job)
       j[p.json] = b.*p.value;
     else if (names == BondNames::report)
@@ -105,7 +111,8 @@ void emit_calibrated(YAML::Emitter& y, const BondParams& b, const std::string& h
     y << YAML::Key << kSectorsKey << YAML::Value << b.joint_sectors;
   }
   for (const BondParameter& p : kBondParameters)
-    if (p.calibrated && uses(b, p)) y << YAML::Key << p.calibrated << YAML::Value << b.*p.value;
+    if (p.calibrated && bond_row_shown(b, p))
+      y << YAML::Key << p.calibrated << YAML::Value << b.*p.value;
   y << YAML::Key << kInputHashKey << YAML::Value << hash;
   if (fitted_for.is_object()) {
     y << YAML::Key << kFittedForKey << YAML::Value << YAML::BeginMap;
@@ -169,9 +176,9 @@ std::vector<std::pair<std::string, std::string>> bond_deck_vars(const BondParams
   std::vector<std::pair<std::string, std::string>> v;
   std::string keys;
   for (const BondParameter& p : kBondParameters) {
-    if (!p.parallel_only)
+    if (!p.parallel_only && !p.joint_only)
       v.emplace_back(p.deck, engine::num(b.*p.value));
-    else if (uses(b, p))
+    else if (bond_row_shown(b, p))
       keys += fmt::format("{}{} {}", keys.empty() ? "" : " ", p.keyword, engine::num(b.*p.value));
   }
   if (b.model == BondModel::flat_joint) {

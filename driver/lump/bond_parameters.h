@@ -50,6 +50,9 @@ struct BondParams {
   // flat joint: friction coefficient of the broken elements (lump.joint_friction);
   // negative: the style's default, tan of friction_angle_deg
   double joint_friction = -1;
+  // flat joint: tension softening lambda of its elements (fix bond/flatjoint
+  // softening; 1: brittle), a fitted row
+  double softening = 1.0;
   std::string origin;     // where they come from, for reports
 };
 
@@ -91,6 +94,10 @@ struct BondParameter {
   bool optional;  // may be absent from a calibration (one made before it existed): then `start`
   bool parallel_only;  // a keyword of the parallel bond only (fix bond/flatjoint refuses it)
   const char* doc;
+  // A keyword of the flat joint only (fix bond/breakable refuses it), left
+  // out of every map while at its start: the jobs and calibrations made
+  // before the row existed keep their ids and read the same.
+  bool joint_only = false;
 };
 
 // The table. The names differ between columns only for history (the
@@ -115,6 +122,8 @@ inline constexpr BondParameter kBondParameters[] = {
    "Share of the bond moments in the bond stresses (absent: 1)"},
   {&BondParams::radius_multiplier,  "radius_multiplier",  nullptr,                 "radius_mult",     "radius_multiplier", "",    {0, true, 2, false},         kFromCard, false, false,
    "Bond disc radius = multiplier x min(Ri, Rj); at most 2, a disc twice the smaller element (Potyondy & Cundall 2004 use 1)"},  // the case's lump.bond_radius_multiplier
+  {&BondParams::softening,          "softening",          "joint_softening",       "joint_softening", "softening",         "",    {1, false, 1000, false},     1.0,       true, false,
+   "Flat joint: tension softening lambda of its elements, the opening at which an element's tension has fallen to zero over the opening at its peak (a linear cohesive law; fracture energy x lambda at the same strength; absent: 1, brittle)", true},
 };
 // clang-format on
 
@@ -131,6 +140,11 @@ inline constexpr const char* kSectorsKey = "joint_sectors";
 // lump_scale): informative, the input_hash already covers it; it names what
 // differs when a section does not apply to a case.
 inline constexpr const char* kFittedForKey = "fitted_for";
+
+// True when the row is one of model b's (a flat joint has no parallel-bond
+// rows, a parallel bond no flat-joint rows) and, for a flat-joint row, off
+// its start: the rows a map of b carries.
+bool bond_row_shown(const BondParams& b, const BondParameter& p);
 
 // The row whose job JSON key is `json`; throws std::logic_error for none.
 inline const BondParameter& bond_parameter(std::string_view json) {

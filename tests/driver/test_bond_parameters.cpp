@@ -46,7 +46,10 @@ BondParams sample() {
 // parameters keeps its key (a new row adds one, and changes the ids).
 TEST(BondParameters, JobJsonKeysAreTheJobIdKeys) {
   const auto j = bond_json(sample(), BondNames::job);
-  EXPECT_EQ(j.size(), std::size(kBondParameters) + 1);  // and the model
+  // and the model; a parallel bond has no flat-joint rows
+  size_t joint_rows = 0;
+  for (const BondParameter& p : kBondParameters) joint_rows += p.joint_only;
+  EXPECT_EQ(j.size(), std::size(kBondParameters) - joint_rows + 1);
   EXPECT_EQ(j.value("bond_model", ""), "parallel");
   const std::pair<const char*, double> pinned[] = {
       {"modulus", 18.69e9},      {"stiffness_ratio", 2.5},   {"tensile", 1.0e7},
@@ -73,8 +76,9 @@ TEST(BondParameters, FlatJointJsonHasItsLayoutAndNoParallelRows) {
   EXPECT_EQ(j.value("bond_model", ""), "flat_joint");
   EXPECT_EQ(j.value("joint_rings", 0), 2);
   EXPECT_EQ(j.value("joint_sectors", 0), 4);
+  // (its own rows only off their start: below)
   for (const BondParameter& p : kBondParameters)
-    EXPECT_EQ(j.contains(p.json), !p.parallel_only) << p.json;
+    EXPECT_EQ(j.contains(p.json), !p.parallel_only && !p.joint_only) << p.json;
   EXPECT_EQ(bond_json(b, BondNames::card).value("calibrated.joint_sectors", 0), 4);
   EXPECT_FALSE(same_model(b, sample()));
   BondParams c = b;
@@ -104,6 +108,35 @@ TEST(BondParameters, DeckVariablesOfEachModel) {
   EXPECT_EQ(value(b, "bond_model_keys"), "elements 1 5");
   b.joint_friction = 0.75;  // lump.joint_friction: the broken elements' mu
   EXPECT_EQ(value(b, "bond_model_keys"), "elements 1 5 joint_friction 0.75");
+  // The tension softening (calibrated.joint_softening): a keyword of the
+  // flat joint's once off its start (1, brittle), and in its maps then only.
+  EXPECT_EQ(value(b, "joint_softening"), "(absent)");
+  EXPECT_FALSE(bond_json(b, BondNames::job).contains("softening"));
+  b.softening = 40;
+  EXPECT_EQ(value(b, "bond_model_keys"), "softening 40 elements 1 5 joint_friction 0.75");
+  EXPECT_EQ(bond_json(b, BondNames::job).value("softening", 0.0), 40.0);
+  EXPECT_EQ(bond_json(b, BondNames::card).value("calibrated.joint_softening", 0.0), 40.0);
+  b.model = BondModel::parallel;  // no such keyword: never passed
+  EXPECT_EQ(value(b, "bond_model_keys"), "moment_factor 0.5");
+  EXPECT_FALSE(bond_json(b, BondNames::job).contains("softening"));
+}
+
+// A flat-joint calibration with its softening reads back; one without it
+// (made before the row) reads the start, 1.
+TEST(BondParameters, JointSofteningRoundTripsAndDefaultsToBrittle) {
+  BondParams b = sample();
+  b.model = BondModel::flat_joint;
+  b.softening = 25;
+  YAML::Emitter y;
+  y << YAML::BeginMap;
+  emit_calibrated(y, b, "abc");
+  y << YAML::EndMap;
+  const YAML::Node node = YAML::Load(y.c_str())["calibrated"];
+  EXPECT_EQ(node["joint_softening"].as<double>(), 25.0);
+  EXPECT_EQ(read_calibrated(node, BondParams{}).softening, 25.0);
+  YAML::Node old = YAML::Clone(node);
+  old.remove("joint_softening");
+  EXPECT_EQ(read_calibrated(old, BondParams{}).softening, 1.0);
 }
 
 // calibrated.yaml's map: today's lines, byte for byte and in this order, then
@@ -205,7 +238,9 @@ TEST(BondParameters, EveryRowReachesTheDecksAndTheStyle) {
     EXPECT_NE(slurp(decks / deck).find(" ${bond_model_keys} "), std::string::npos) << deck;
   }
   for (const BondParameter& p : kBondParameters) {
-    if (p.parallel_only) {
+    if (p.joint_only) {
+      // Passed in bond_model_keys by the flat joint only (its start: not at all).
+    } else if (p.parallel_only) {
       for (const char* deck : declaring)
         EXPECT_NE(slurp(decks / deck).find(std::string("bond_model_keys  index \"") + p.keyword),
                   std::string::npos)

@@ -101,8 +101,13 @@ TEST(CalibrateSensitivity, LeversAndStepsFollowTheTable) {
 
   p.model = BondModel::flat_joint;
   const std::vector<Lever> fj = sensitivity_levers(p);
-  ASSERT_EQ(fj.size(), 5u);
+  ASSERT_EQ(fj.size(), 6u);  // and its tension softening, x 1.2 from 1 (brittle)
   for (const Lever& l : fj) EXPECT_FALSE(l.row->parallel_only) << l.row->calibrated;
+  EXPECT_TRUE(lever(p, "joint_softening").multiplicative);
+  EXPECT_DOUBLE_EQ(lever(p, "joint_softening").to, 1.2);
+  EXPECT_DOUBLE_EQ(perturbed(p, lever(p, "joint_softening")).softening, 1.2);
+  p.model = BondModel::parallel;  // no softening lever: the parallel bond has none
+  for (const Lever& l : sensitivity_levers(p)) EXPECT_FALSE(l.row->joint_only) << l.row->calibrated;
 }
 
 // The closed form: (dT/T)/(dx/x) for E, UCS, tensile and d nu / d ln x for

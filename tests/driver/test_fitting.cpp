@@ -180,12 +180,16 @@ struct Material {
   // opens in tension, so K_IC follows sigma_b, with a weak coupling to the
   // cohesion ratio and the stiffness ratio.
   double kic_per_sigma = 0.0;
+  // The tension softening lambda: T, UCS and K_IC x lambda^0.3, ^0.2 and
+  // ^0.6 (the measured slopes 0.21-0.48, 0.15-0.19, 0.46-0.60; bench/README.md,
+  // "Tension softening with the direct test"; the prior's 0.33-0.35, 0.17, 0.55).
   Iteration test(const BondParams& p) const {
     const double le = std::log(p.modulus), lk = std::log(p.stiffness_ratio),
-                 ls = std::log(p.tensile), lr = std::log(p.cohesion / p.tensile);
+                 ls = std::log(p.tensile), lr = std::log(p.cohesion / p.tensile),
+                 ll = std::log(p.softening);
     const double E = std::exp(0.93 * le - 0.25 * lk + 0.0);
     const double nu = 0.06 + 0.13 * lk + 0.02 * lr;
-    const double T = std::exp(ls + 0.45 * lr - 0.15);
+    const double T = std::exp(ls + 0.45 * lr - 0.15 + 0.3 * ll);
     // UCS/T rises with the ratio c / sigma as 4 rho^0.6 and saturates at
     // ratio_max (a smooth minimum of the two).
     const double free_ratio = 4.0 * std::pow(p.cohesion / p.tensile, 0.6);
@@ -195,11 +199,11 @@ struct Material {
     it.p = p;
     it.ucs.r.youngs_modulus = E * 0.35;
     it.ucs.r.poisson_ratio = nu;
-    it.ucs.r.ucs = R * T;
+    it.ucs.r.ucs = R * T * std::exp(-0.1 * ll);
     it.br.r.tensile_strength = T;
     if (kic_per_sigma > 0) {
       it.scb.emplace();
-      it.scb->toughness = kic_per_sigma * p.tensile * std::exp(0.05 * lr - 0.05 * lk);
+      it.scb->toughness = kic_per_sigma * p.tensile * std::exp(0.05 * lr - 0.05 * lk + 0.6 * ll);
     }
     return it;
   }
@@ -406,10 +410,10 @@ Targets card_of(const Material& m) {
 
 // The toughness as a fifth target (flat joints; docs/calibration.md, "The
 // toughness as a target"). A card made by the synthetic material itself at
-// known parameters (E_b 40 GPa, kn/ks 2, sigma_b 4 MPa, c/sigma_b 12), so
-// that all five targets can be met together: from the start 3-7 x off, the
-// fit meets E, nu, UCS, T and K_IC within tolerance in at most 10
-// iterations, and reaches the card's sigma_b (within 10 %).
+// known parameters (E_b 40 GPa, kn/ks 2, sigma_b 4 MPa, c/sigma_b 12,
+// brittle), so that all five targets can be met together: from the start
+// 3-7 x off, the fit meets E, nu, UCS, T and K_IC within tolerance in at
+// most 10 iterations, near the card's sigma_b and brittle joint (below).
 TEST(Fitting, ToughnessTargetPinsTheBondTensileStrength) {
   const Material m{30.0, 0.1};
   const Targets t = card_of(m);
@@ -422,16 +426,54 @@ TEST(Fitting, ToughnessTargetPinsTheBondTensileStrength) {
   EXPECT_TRUE(best.converged) << hist.size() << " iterations, score " << best.score
                               << ", K_IC error " << best.err_kic;
   EXPECT_LE(best.err_kic, 0.1);
-  EXPECT_NEAR(best.p.tensile / truth_params().tensile, 1.0, 0.1);
+  // The softening is a lever too (K_IC a target): T and K_IC within 10 %
+  // each leave lambda a band (K_IC/T x lambda^0.3 here: lambda up to ~1.9),
+  // and sigma_b trades against it along T. The fit stays near the card's
+  // brittle joint: lambda below 1.6, sigma_b within 25 % (measured: 1.48,
+  // -24.5 %, all five met in 3 iterations).
+  EXPECT_LT(best.p.softening, 1.6);
+  EXPECT_NEAR(best.p.tensile / truth_params().tensile, 1.0, 0.25);
+}
+
+// A card whose K_IC/T no brittle joint reaches: made by the synthetic
+// material at the parameters above with tension softening lambda 40 (K_IC/T
+// x 40^0.3 = 3.0 the brittle material's at those bonds, as the sandstone
+// asks of the flat joint: bench/README.md, "Tension softening with the
+// direct test"). From the brittle start the fit frees the softening (K_IC a
+// target) and meets all five targets within tolerance in at most 12
+// iterations, with lambda within x/÷ 1.5 of the card's. Without K_IC a
+// target the softening never moves.
+TEST(Fitting, ToughnessBeyondTheBrittleRatioIsMetBySoftening) {
+  const Material m{30.0, 0.1};
+  BondParams truth = truth_params();
+  truth.softening = 40.0;
+  const Iteration card_it = m.test(truth);
+  Targets t{card_it.ucs.r.youngs_modulus, card_it.ucs.r.poisson_ratio, card_it.ucs.r.ucs,
+            card_it.br.r.tensile_strength};
+  t.toughness = card_it.scb->toughness;
+  const Fitting fit(t, 0.1);
+  BondParams p = start();
+  p.model = BondModel::flat_joint;
+  ASSERT_EQ(p.softening, 1.0);
+  const auto hist = run_fit(fit, m, p, 12);
+  const Iteration& best = hist[fit.best(hist)];
+  EXPECT_TRUE(best.converged) << hist.size() << " iterations, score " << best.score
+                              << ", K_IC error " << best.err_kic << ", lambda " << best.p.softening;
+  EXPECT_NEAR(std::log(best.p.softening / 40.0), 0.0, std::log(1.5)) << best.p.softening;
+  Targets four = t;
+  four.toughness = 0;
+  for (const Iteration& it : run_fit(Fitting(four, 0.1), m, p, 6)) EXPECT_EQ(it.p.softening, 1.0);
 }
 
 // K_IC out of reach at the sigma_b the tensile strength needs (the card's
-// K_IC 4 x what the material gives there): the fit never passes quietly:
+// K_IC 20 x what the material gives there): the fit never passes quietly:
 // not converged, and the K_IC error is what it says it misses.
 TEST(Fitting, ToughnessOutOfReachIsNeverAQuietPass) {
   const Material m{30.0, 0.1};
   Targets t = card_of(m);
-  t.toughness *= 4.0;
+  // 20 x: beyond what the softening reaches too (K_IC/T x lambda^0.3, at
+  // most 1000^0.3 = 7.9; until the softening was a lever, 4 x was)
+  t.toughness *= 20.0;
   const Fitting fit(t, 0.1);
   BondParams p = start();
   p.model = BondModel::flat_joint;

@@ -28,6 +28,9 @@ inline constexpr double kMaxFrictionAngle = 60.0;
 inline constexpr double kMinStiffnessRatio = 0.5;
 inline constexpr double kMaxStiffnessRatio = 20.0;
 inline constexpr double kMinCohesionRatio = 0.1;
+// Bound of the flat joint's tension softening lambda from above (the
+// calibrated row's range; 1 is brittle, the bound from below).
+inline constexpr double kMaxSoftening = 1000.0;
 // The local model: iterations it uses at most, the ridge weight of the prior
 // slopes (as a difference of 0.14 in log parameters), the step's damping
 // (relative to the prior's diagonal), and the UCS's weight when the ratio is
@@ -83,7 +86,7 @@ using FitMat = MatN<kFitResponses>;
 using FitVec = VecN<kFitResponses>;
 struct LocalModelPrior {
   FitMat J0{}, lo{}, hi{};
-  Vec4 max_step{};
+  ParamVec max_step{};
 };
 // direct: the tensile row of the direct tension test (calibrate.tensile_test).
 LocalModelPrior flat_joint_prior(bool direct = false);

@@ -58,7 +58,7 @@ MatN<Ny> estimate_jacobian(const std::vector<ModelPointN<Ny>>& pts, const MatN<N
 }
 
 template <size_t Ny>
-VecN<Ny> predict(const MatN<Ny>& J, const Vec4& du) {
+VecN<Ny> predict(const MatN<Ny>& J, const ParamVec& du) {
   VecN<Ny> dy{};
   for (size_t i = 0; i < Ny; ++i)
     for (size_t m = 0; m < kNu; ++m) dy[i] += J[i][m] * du[m];
@@ -66,14 +66,15 @@ VecN<Ny> predict(const MatN<Ny>& J, const Vec4& du) {
 }
 
 template <size_t Ny>
-Vec4 damped_step(const MatN<Ny>& J, const VecN<Ny>& e, const Vec4& u, const StepRuleN<Ny>& rule) {
-  Vec4 du{};
+ParamVec damped_step(const MatN<Ny>& J, const VecN<Ny>& e, const ParamVec& u,
+                     const StepRuleN<Ny>& rule) {
+  ParamVec du{};
   std::array<bool, kNu> fixed{};
   for (size_t m = 0; m < kNu; ++m) {
     fixed[m] = rule.free[m] == 0.0;
     if (fixed[m]) du[m] = rule.held[m];
   }
-  for (int round = 0; round < 5; ++round) {
+  for (size_t round = 0; round <= kNu; ++round) {
     // Normal equations of the free components, the fixed ones moved to the
     // right-hand side: (J_f^T W^2 J_f + D) du_f = J_f^T W^2 (e - J_x du_x).
     std::vector<size_t> idx;
@@ -131,9 +132,11 @@ template MatN<4> estimate_jacobian<4>(const std::vector<ModelPointN<4>>&, const 
                                       const MatN<4>&, const MatN<4>&);
 template MatN<5> estimate_jacobian<5>(const std::vector<ModelPointN<5>>&, const MatN<5>&, double,
                                       const MatN<5>&, const MatN<5>&);
-template VecN<4> predict<4>(const MatN<4>&, const Vec4&);
-template VecN<5> predict<5>(const MatN<5>&, const Vec4&);
-template Vec4 damped_step<4>(const MatN<4>&, const VecN<4>&, const Vec4&, const StepRuleN<4>&);
-template Vec4 damped_step<5>(const MatN<5>&, const VecN<5>&, const Vec4&, const StepRuleN<5>&);
+template VecN<4> predict<4>(const MatN<4>&, const ParamVec&);
+template VecN<5> predict<5>(const MatN<5>&, const ParamVec&);
+template ParamVec damped_step<4>(const MatN<4>&, const VecN<4>&, const ParamVec&,
+                                 const StepRuleN<4>&);
+template ParamVec damped_step<5>(const MatN<5>&, const VecN<5>&, const ParamVec&,
+                                 const StepRuleN<5>&);
 
 }  // namespace mill::calibrate

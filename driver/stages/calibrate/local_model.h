@@ -1,7 +1,8 @@
 // The fit's local linear model (docs/calibration.md, "Fitting scheme"): the
-// four continuous bond parameters in log space,
-//   u = (ln E_b, ln kn/ks, ln sigma_b, ln c/sigma_b),
-// against the four targets,
+// continuous bond parameters in log space,
+//   u = (ln E_b, ln kn/ks, ln sigma_b, ln c/sigma_b, ln lambda),
+// lambda the flat joint's tension softening (held at its value unless the
+// toughness is a target: StepRuleN::free), against the four targets,
 //   y = (ln E, nu, ln UCS, ln T),
 // and, when the toughness is a target, a fifth, ln K_IC (Ny = 5),
 // linearised as y(u + du) ~ y(u) + J du. J is estimated from the iterations
@@ -21,20 +22,20 @@
 
 namespace mill::calibrate {
 
-inline constexpr size_t kNu = 4;  // parameters u
+inline constexpr size_t kNu = 5;  // parameters u
 inline constexpr size_t kNy = 4;  // responses y of the four macro targets
-using Vec4 = std::array<double, 4>;
+using ParamVec = std::array<double, kNu>;
 // Ny responses (4: E, nu, UCS, T; 5: and the toughness K_IC).
 template <size_t Ny>
 using VecN = std::array<double, Ny>;
 template <size_t Ny>
-using MatN = std::array<Vec4, Ny>;  // [response][parameter]
+using MatN = std::array<ParamVec, Ny>;  // [response][parameter]
 using Mat4 = MatN<4>;
 
 // One iteration's point: its parameters and responses.
 template <size_t Ny>
 struct ModelPointN {
-  Vec4 u{};
+  ParamVec u{};
   VecN<Ny> y{};
 };
 using ModelPoint = ModelPointN<4>;
@@ -54,27 +55,30 @@ struct StepRuleN {
   VecN<Ny>
       weight{};     // per response: 1 / its tolerance (errors in tolerance units; 0: not a target)
   double mu = 0.1;  // Levenberg-Marquardt damping
-  Vec4 scale{};     // per parameter: its prior slope on its own target, weighted
-  Vec4 max_step{};  // |du_m| at most this (a trust region per parameter)
-  Vec4 lower{}, upper{};  // bounds of u_m + du_m
-  Vec4 free{1, 1, 1, 1};  // 0: the parameter takes its held value this step
-  Vec4 held{};            // the step of a parameter that is not free
+  ParamVec scale{};           // per parameter: its prior slope on its own target, weighted
+  ParamVec max_step{};        // |du_m| at most this (a trust region per parameter)
+  ParamVec lower{}, upper{};  // bounds of u_m + du_m
+  // 0: the parameter takes its held value this step (the softening is held
+  // unless a step frees it)
+  ParamVec free{1, 1, 1, 1, 0};
+  ParamVec held{};  // the step of a parameter that is not free
 };
 using StepRule = StepRuleN<4>;
 
 // The step du minimising sum_i (w_i (J du - e)_i)^2 + mu sum_m
 // (scale_m du_m)^2 with e = target - y, each du_m within its max_step
 // and u_m + du_m within its bounds (a component past them is fixed there and
-// the rest re-solved, at most 4 rounds). Components with free = 0 take
+// the rest re-solved, at most 5 rounds). Components with free = 0 take
 // their held value.
 template <size_t Ny>
-Vec4 damped_step(const MatN<Ny>& J, const VecN<Ny>& e, const Vec4& u, const StepRuleN<Ny>& rule);
+ParamVec damped_step(const MatN<Ny>& J, const VecN<Ny>& e, const ParamVec& u,
+                     const StepRuleN<Ny>& rule);
 
 // J du (the responses' predicted change).
 template <size_t Ny>
-VecN<Ny> predict(const MatN<Ny>& J, const Vec4& du);
+VecN<Ny> predict(const MatN<Ny>& J, const ParamVec& du);
 
-// Solves the n x n system A x = b (n <= 4) by Gaussian elimination with
+// Solves the n x n system A x = b (n <= kNu) by Gaussian elimination with
 // partial pivoting; false if A is singular (pivot below 1e-300).
 bool solve_small(std::vector<std::vector<double>> A, std::vector<double> b,
                  std::vector<double>& x);

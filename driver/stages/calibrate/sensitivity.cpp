@@ -90,6 +90,7 @@ std::vector<Lever> sensitivity_levers(const BondParams& p) {
   for (const BondParameter& row : kBondParameters) {
     if (!row.calibrated) continue;  // not fitted: the case sets it
     if (row.parallel_only && p.model != BondModel::parallel) continue;
+    if (row.joint_only && p.model != BondModel::flat_joint) continue;
     Lever l;
     l.row = &row;
     l.from = p.*row.value;
