@@ -540,6 +540,13 @@ void FixBondBreakable::create_bonds() {
            "(gap < %g x min radius)",
            label().c_str(), nb, global[1], coord, gap_);
   message(line);
+  if (flat_joint_ && fj_softening_ > 1.0) {
+    snprintf(line, sizeof(line),
+             "%sthe interface elements soften in tension: softening %g (each element's "
+             "fracture energy x %g at the same strength)",
+             label().c_str(), fj_softening_, fj_softening_);
+    message(line);
+  }
   if (unbonded_fraction_ > 0.0) {
     snprintf(line, sizeof(line),
              "%s%.0f more pairs in bonding range left unbonded "

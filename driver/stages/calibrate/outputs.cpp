@@ -420,8 +420,9 @@ std::string Report::markdown() const {
       "multiplier | {:g} |\n\n",
       bond_model_text(b_.p), b_.p.modulus / 1e9, b_.p.stiffness_ratio, b_.p.tensile / 1e6,
       b_.p.cohesion / 1e6, b_.p.friction_angle_deg,
-      b_.p.model == BondModel::parallel ? fmt::format("| moment factor | {:g} |\n", b_.p.moment_factor)
-                                        : std::string(),
+      b_.p.model == BondModel::parallel
+          ? fmt::format("| moment factor | {:g} |\n", b_.p.moment_factor)
+          : fmt::format("| tension softening lambda (1: brittle) | {:.3g} |\n", b_.p.softening),
       b_.p.radius_multiplier);
   // The toughness fit adds a K_IC column.
   const bool kic = t_.toughness > 0;
@@ -433,19 +434,19 @@ std::string Report::markdown() const {
         "(iterations[].packings).\n\n",
         b_.more.size() + 1);
   md << fmt::format(
-      "| it | E_b (GPa) | kn/ks | sigma_b (MPa) | c (MPa) | phi (deg) | beta | "
+      "| it | E_b (GPa) | kn/ks | sigma_b (MPa) | c (MPa) | {}phi (deg) | beta | "
       "E (GPa) | nu | UCS (MPa) | tensile (MPa) | UCS/tensile | {}"
       "wall (s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|{}---|\n",
-      kic ? "K_IC (MPa m^0.5) | " : "", kic ? "---|" : "");
+      kic ? "lambda | " : "", kic ? "K_IC (MPa m^0.5) | " : "", kic ? "---|---|" : "");
   for (size_t i = 0; i < hist_.size(); ++i) {
     const auto& it = hist_[i];
     const Measured m = it.measured();
     md << fmt::format(
-        "| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.0f} | {:g} | {:.2f} | {:.3f} | {:.2f} | "
+        "| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {}{:.0f} | {:g} | {:.2f} | {:.3f} | {:.2f} | "
         "{:.2f} | {:.2f} | {}{:.0f} |\n",
         i + 1, it.p.modulus / 1e9, it.p.stiffness_ratio, it.p.tensile / 1e6, it.p.cohesion / 1e6,
-        it.p.friction_angle_deg, it.p.moment_factor, m.E / 1e9, m.nu, m.ucs / 1e6, m.tensile / 1e6,
-        m.ucs / m.tensile,
+        kic ? fmt::format("{:.3g} | ", it.p.softening) : std::string(), it.p.friction_angle_deg,
+        it.p.moment_factor, m.E / 1e9, m.nu, m.ucs / 1e6, m.tensile / 1e6, m.ucs / m.tensile,
         !kic     ? std::string()
         : it.scb ? fmt::format("{:.3f} | ", it.scb->toughness / 1e6)
                  : std::string("- | "),
