@@ -259,10 +259,11 @@ BondParams Fitting::joint_update(const std::vector<Iteration>& hist,
     notes.push_back(
         fmt::format("cohesion capped at {:g} x the bond tensile strength", kMaxCohesionRatio));
   p.cohesion = ratio * p.tensile;
-  if (du[4] != 0.0) p.softening = std::exp(u[4] + du[4]);  // held: exactly as it was
-  if (du[4] != 0.0)
+  if (du[4] != 0.0) {  // held: exactly as it was
+    p.softening = std::exp(u[4] + du[4]);
     notes.push_back(fmt::format("iteration {}: tension softening {:.3g} -> {:.3g}", hist.size(),
                                 now.p.softening, p.softening));
+  }
   p.origin = "calibrate iteration " + std::to_string(hist.size() + 1);
   return p;
 }
