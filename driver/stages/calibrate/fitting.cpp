@@ -184,9 +184,10 @@ LocalModelPrior flat_joint_prior(bool direct) {
   return m;
 }
 
-// The flat joint's next parameters: one damped Gauss-Newton step of all
-// four continuous parameters on the local linear model of the iterations
-// so far (local_model.h). A flat joint has no coarse lever (its elements
+// The flat joint's next parameters: one damped Gauss-Newton step of its
+// continuous parameters (the softening only when K_IC is a target with the
+// direct test) on the local linear model of the iterations so far
+// (local_model.h). A flat joint has no coarse lever (its elements
 // carry the moments whole; its friction angle is also its broken elements'
 // friction).
 BondParams Fitting::joint_update(const std::vector<Iteration>& hist,
