@@ -20,6 +20,14 @@ using namespace mill::e2e;
 namespace {
 const std::string kData = MILL_TEST_DATA;
 
+// `orchestrate --case <dir>/<name>.yaml --stage calibrate --output run`, its
+// log in <dir>/<name>.log; the exit status.
+int calibrate(const fs::path& dir, const std::string& name, const fs::path& run) {
+  return orchestrate(
+      "--case " + (dir / (name + ".yaml")).string() + " --stage calibrate --output " + run.string(),
+      dir / (name + ".log"));
+}
+
 nlohmann::json result_of(const fs::path& run, const std::string& job) {
   return nlohmann::json::parse(slurp(run / "breakage" / "jobs" / job / "result.json"));
 }
@@ -84,11 +92,7 @@ TEST(FlatJointCalibration, ToughnessIsATargetOfTheFit) {
   spit(dir / "off.yaml",
        "name: kic_off\n" + base + cal + ", max_iterations: 1, fit_toughness: false}\n");
   const fs::path run = dir / "run";
-  ASSERT_EQ(orchestrate("--case " + (dir / "on.yaml").string() + " --stage calibrate --output " +
-                            run.string(),
-                        dir / "on.log"),
-            0)
-      << slurp(dir / "on.log");
+  ASSERT_EQ(calibrate(dir, "on", run), 0) << slurp(dir / "on.log");
   const fs::path job = run / "calibrate" / "jobs" / "calibration";
   const auto r = nlohmann::json::parse(slurp(job / "report.json"));
   EXPECT_DOUBLE_EQ(r["targets"]["fracture_toughness"].get<double>(), 0.73e6) << r["targets"];
@@ -153,11 +157,7 @@ TEST(FlatJointCalibration, ToughnessIsATargetOfTheFit) {
 
   // The key off: another job id (the fit differs), no bend test per iteration.
   const fs::path run_off = dir / "run_off";
-  ASSERT_EQ(orchestrate("--case " + (dir / "off.yaml").string() + " --stage calibrate --output " +
-                            run_off.string(),
-                        dir / "off.log"),
-            0)
-      << slurp(dir / "off.log");
+  ASSERT_EQ(calibrate(dir, "off", run_off), 0) << slurp(dir / "off.log");
   const fs::path job_off = run_off / "calibrate" / "jobs" / "calibration";
   EXPECT_FALSE(fs::exists(job_off / "runs" / "it1_scb"));
   // The check after the fit: its own two half discs.
@@ -192,11 +192,7 @@ TEST(FlatJointCalibration, DirectToughnessFitSoftensTheJoints) {
        "tensile_test: direct, max_iterations: 2}\n"
        "resources: {np: 1, jobs: 1}\n");
   const fs::path run = dir / "run";
-  ASSERT_EQ(orchestrate("--case " + (dir / "soft.yaml").string() + " --stage calibrate --output " +
-                            run.string(),
-                        dir / "soft.log"),
-            0)
-      << slurp(dir / "soft.log");
+  ASSERT_EQ(calibrate(dir, "soft", run), 0) << slurp(dir / "soft.log");
   const fs::path job = run / "calibrate" / "jobs" / "calibration";
   const auto r = nlohmann::json::parse(slurp(job / "report.json"));
   const auto& its = r["iterations"];
