@@ -157,6 +157,21 @@ JkFit FitJk(const std::vector<double>& e, const std::vector<double>& t) {
     f.a_se_percent = std::sqrt(s2 * jtj[1][1] / det);
     f.b_se_t_per_kwh = std::sqrt(s2 * jtj[0][0] / det);
   }
+  // Past saturation at every energy: once b Ecs_min > ln 20 the lowest
+  // impact's t10 is within 5 % of A, and any larger b fits as well (the
+  // sum of squares is flat in b): the sweep bounds b from below only, and
+  // a least-squares b (and A x b) would be a number of the optimiser's, not
+  // of the ore's.
+  const double e_min = *energies.begin();
+  if (b * e_min > kSaturatedBEcs) {
+    f.ok = false;
+    f.reason = fmt::format(
+        "every impact is past saturation: t10 at the lowest energy ({:.3g} kWh/t) is within "
+        "5 % of A ({:.3g} %), so b is only bounded from below (b > ln 20 / Ecs = {:.3g} t/kWh, "
+        "A x b > {:.3g}); the sweep needs impacts below the critical speed",
+        e_min, a, kSaturatedBEcs / e_min, a * kSaturatedBEcs / e_min);
+    return f;
+  }
   if (b * *energies.rbegin() < 0.5) {
     f.note =
         "the sweep stays on the initial slope (b x largest Ecs < 0.5): A and b are poorly "

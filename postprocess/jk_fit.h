@@ -37,10 +37,15 @@ struct JkFit {
   double ab() const { return a_percent * b_t_per_kwh; }
 };
 
+// b x Ecs beyond which t10 is within 5 % of A: ln 20.
+inline constexpr double kSaturatedBEcs = 2.995732273553991;
+
 // Fits A and b to (Ecs, t10) pairs by Levenberg-Marquardt on the sum of
 // squared t10 residuals, from a start read off the data (A a little above the
 // largest t10, b from the linearised relation). Needs at least 3 points at
 // 2 or more distinct energies > 0 and some t10 > 0; else !ok with the reason.
+// A fit whose every point is past saturation (b x the lowest Ecs > ln 20:
+// b bounded from below only) is !ok too, the reason giving that bound.
 // Throws PostError on mismatched lengths or non-finite values.
 JkFit FitJk(const std::vector<double>& ecs_kwh_t, const std::vector<double>& t10_percent);
 

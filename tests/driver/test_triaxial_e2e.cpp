@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -22,6 +23,7 @@
 #include "engine/runner.h"
 #include "lab_context.h"
 #include "lump/material.h"
+#include "postprocess/energy_ledger.h"
 #include "postprocess/lab_tests.h"
 #include "progress.h"
 #include "stages/calibrate/checks.h"
@@ -154,6 +156,95 @@ TEST(TriaxialEnvelope, MiddlePeakLiesOnTheMohrCoulombLineOfTheOuterConfinements)
       predicted / 1e6, 100 * deviation, kElements, sp.cyl_r * 1e3, seconds);
   EXPECT_LE(std::abs(deviation), 0.05) << summary;
   std::cout << summary << "\n";
+}
+
+// A shell element that has come loose is no longer pressed. Measured: a
+// corner element of a 400-element flat-joint cylinder at 10.5 MPa lost its
+// bonds, the constant push carried it across the open end face and the
+// energy ledger stopped the run at 411 m/s. Here the specimen is a simple
+// cubic lattice of 1 mm elements (centres 2 mm apart, 13 columns x 9 layers,
+// bonded face to face) with one shell element at mid-height standing alone:
+// its three neighbours removed, a 2 mm gap between it and the next element
+// in. A deck that pushed it (the pressure shared over the whole shell: about
+// 96 N at 5 MPa on an element of 10.8 mg) would send it across the gap at
+// tens of m/s during the hydrostatic ramp (closed form: 67 m/s); pressed
+// only while held, nothing moves faster than the quasi-static loading.
+TEST(TriaxialConfinement, LooseShellElementIsNotPushed) {
+  const auto dir = scratch("triaxial_loose");
+  spit(dir / "case.yaml",
+       "name: triaxial_loose\nore: {card: sandstone}\n"
+       "lump: {n_elements: 150, diameter: 0.02, bond_gap: 0.2}\n"
+       "calibrate: {strain_rate: 0.5}\nresources: {np: 1, jobs: 1}\n");
+  test::LabContext lab_ctx(dir, MILL_PROJECT_DIR);
+  const config::CaseConfig& cfg = lab_ctx.cfg;
+  StageContext& ctx = lab_ctx.ctx;
+
+  constexpr double r = 1e-3, rho = 2580.0;
+  std::vector<std::array<int, 3>> cells;  // lattice indices, centres at 2 r x index
+  for (int i = -2; i <= 2; ++i)
+    for (int j = -2; j <= 2; ++j)
+      for (int k = -4; k <= 4; ++k) {
+        if (4 * (i * i + j * j) > 19) continue;  // centres within 4.45 mm of the axis
+        const bool gone = (i == 1 && j == 0 && k == 0) || (i == 2 && j == 0 && std::abs(k) == 1);
+        if (!gone) cells.push_back({i, j, k});
+      }
+  ASSERT_EQ(cells.size(), 13u * 9u - 3u);
+  std::string atoms;
+  for (std::size_t n = 0; n < cells.size(); ++n)
+    atoms += fmt::format("{} 1 {} {} {} {} {}\n", n + 1, 2 * r, rho, 2 * r * cells[n][0],
+                         2 * r * cells[n][1], 2 * r * cells[n][2]);
+  spit(dir / "ball.data", fmt::format("lattice\n\n{} atoms\n2 atom types\n\n-0.02 0.02 xlo xhi\n"
+                                      "-0.02 0.02 ylo yhi\n-0.02 0.02 zlo zhi\n\nAtoms\n\n{}",
+                                      cells.size(), atoms));
+  calibrate::Specimen sp;
+  sp.ball = dir / "ball.data";
+  sp.ball_elements = static_cast<long>(cells.size());
+  sp.mean_radius = r;
+  sp.cyl_r = 4.45e-3;  // the lattice's 13 columns; the shell: the four at 4 mm
+  // The lattice's columns carry the axial load face to face and do not fail
+  // before the strain cap; a UCS of 1 MPa here only shortens the axial stage
+  // (its cap is 4 x (UCS + 5 p) / E).
+  const calibrate::Targets targets{cfg.ore.real("youngs_modulus"), cfg.ore.real("poisson_ratio"),
+                                   1e6, cfg.ore.real("tensile_strength")};
+  calibrate::LabBench lab(ctx, "triaxial_loose", dir, sp, targets);
+  constexpr double p = 5e6;
+  const calibrate::TriaxialRun t =
+      lab.triaxial(fixed_bonds(cfg), kStrainRate, p, {"triaxial_loose", "triaxial at 5 MPa", 0.0});
+
+  // The hydrostatic stage: the ramp p / (E strain rate) and half of it held.
+  const double hydrostatic_end = 1.5 * p / (cfg.ore.real("youngs_modulus") * kStrainRate);
+  const post::EnergyLedger ledger =
+      post::ReadEnergyLedger((dir / "runs" / "triaxial_loose" / "ledger.csv").string());
+  const auto& time = ledger.column("time_s");
+  const auto& speed = ledger.column("max_speed_m_s");
+  double fastest = 0.0;
+  std::size_t rows = 0;
+  for (std::size_t k = 0; k < ledger.rows(); ++k)
+    if (time[k] <= hydrostatic_end) {
+      fastest = std::max(fastest, speed[k]);
+      ++rows;
+    }
+  ASSERT_GE(rows, 3u) << "ledger rows in the hydrostatic stage (until " << hydrostatic_end << " s)";
+  // Quasi-static: the lattice's own motion under the ramp is mm/s; a pushed
+  // loose element reaches tens of m/s. 1 m/s between them.
+  EXPECT_LT(fastest, 1.0) << "fastest element in the hydrostatic stage, m/s";
+  // The held shell elements carry the whole pressure, less the subtracted
+  // mean: sum_i f (1 - u_i . m) = p A_lat (1 - |m|^2), m the mean of their
+  // unit radial vectors. Held: the four columns at 4 mm (9 elements each)
+  // but the two removed and the loose one, so the +x column has 6:
+  // m_x = (6 - 9) / 33. With the loose element counted (m_x = (7 - 9) / 34)
+  // the share would be about 0.997 instead of 0.9917 (measured 0.9968).
+  const post::TriaxialCurve curve =
+      post::ReadTriaxialCurve((dir / "runs" / "triaxial_loose" / "triaxial_curve.txt").string());
+  ASSERT_FALSE(curve.confining_force.empty());
+  const double a_lat = calibrate::info_at(t.info, "lateral_area", t.info_file);
+  const double m_x = (6.0 - 9.0) / 33.0;
+  EXPECT_NEAR(curve.confining_force.front() / (p * a_lat), 1.0 - m_x * m_x, 1e-3)
+      << "confining force at the start of the axial loading, N: " << curve.confining_force.front();
+  std::cout << fmt::format(
+      "loose shell element: fastest element {:.4f} m/s until {:.3g} s; "
+      "confining force {:.2f} N of p x lateral area {:.2f} N\n",
+      fastest, hydrostatic_end, curve.confining_force.front(), p * a_lat);
 }
 
 // A triaxial check whose engine run fails (here a deck the engine rejects

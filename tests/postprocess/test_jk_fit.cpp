@@ -68,6 +68,37 @@ TEST(JkFit, TooFewPointsOrNoBreakageIsNotAFit) {
   EXPECT_THROW(FitJk({0.1, 0.2}, {1.0}), PostError);
 }
 
+// A sweep whose every impact is past saturation: t10 = A (1 - exp(-b Ecs))
+// with b x the lowest Ecs = 8 (t10 there 99.97 % of A) plus +-1 % scatter,
+// as the default case's transport impacts (53-149 m/s) gave a lump whose
+// critical speed is about 30 m/s: the sum of squares is flat in b beyond
+// the data, so b (and A x b: 4.06e5 there) is not the ore's. Not a fit;
+// the reason gives the closed-form bound b > ln 20 / Ecs_min. The same
+// relation sampled down to b Ecs = 0.4 still fits (b within 2 %).
+TEST(JkFit, ASweepPastSaturationEverywhereIsNotAFit) {
+  const double a_true = 96.0, b_true = 20.0, e_min = 0.4;
+  std::vector<double> e, t;
+  const double wiggle[] = {0.01, -0.01, 0.005, -0.005, 0.0, 0.01};
+  for (int k = 0; k < 6; ++k) {
+    e.push_back(e_min * (1 + 0.5 * k));
+    t.push_back(JkT10(a_true, b_true, e.back()) * (1 + wiggle[k]));
+  }
+  const JkFit f = FitJk(e, t);
+  EXPECT_FALSE(f.ok) << "A " << f.a_percent << " b " << f.b_t_per_kwh;
+  EXPECT_NE(f.reason.find("past saturation"), std::string::npos) << f.reason;
+  // ln 20 / 0.4 = 7.49 t/kWh.
+  EXPECT_NE(f.reason.find("b > ln 20 / Ecs = 7.49 t/kWh"), std::string::npos) << f.reason;
+
+  std::vector<double> e2, t2;
+  for (double x : {0.02, 0.05, 0.1, 0.2, 0.4, 0.8}) {
+    e2.push_back(x);
+    t2.push_back(JkT10(a_true, b_true, x));
+  }
+  const JkFit g = FitJk(e2, t2);
+  ASSERT_TRUE(g.ok) << g.reason;
+  EXPECT_NEAR(g.b_t_per_kwh, b_true, 0.02 * b_true);
+}
+
 TEST(JkFit, ARepeatWithTooFewPointsIsLeftOutOfTheSpread) {
   std::vector<JkPoint> pts;
   for (double e : {0.1, 0.3, 0.9, 2.0}) pts.push_back({e, JkT10(40, 1.2, e), 0});
