@@ -143,20 +143,6 @@ JkFit FitJk(const std::vector<double>& e, const std::vector<double>& t) {
   f.b_t_per_kwh = b;
   f.rms_residual_percent = std::sqrt(s / static_cast<double>(e.size()));
 
-  // Standard errors: s^2 (J^T J)^-1 at the optimum, s^2 = SSR / (n - 2).
-  double jtj[2][2] = {{0, 0}, {0, 0}};
-  for (std::size_t i = 0; i < e.size(); ++i) {
-    const double x = std::exp(-b * e[i]);
-    const double g[2] = {1.0 - x, a * e[i] * x};
-    for (int p = 0; p < 2; ++p)
-      for (int q = 0; q < 2; ++q) jtj[p][q] += g[p] * g[q];
-  }
-  const double det = jtj[0][0] * jtj[1][1] - jtj[0][1] * jtj[0][1];
-  if (e.size() > 2 && det > 0.0) {
-    const double s2 = s / static_cast<double>(e.size() - 2);
-    f.a_se_percent = std::sqrt(s2 * jtj[1][1] / det);
-    f.b_se_t_per_kwh = std::sqrt(s2 * jtj[0][0] / det);
-  }
   // Past saturation at every energy: once b Ecs_min > ln 20 the lowest
   // impact's t10 is within 5 % of A, and any larger b fits as well (the
   // sum of squares is flat in b): the sweep bounds b from below only, and
@@ -171,6 +157,20 @@ JkFit FitJk(const std::vector<double>& e, const std::vector<double>& t) {
         "A x b > {:.3g}); the sweep needs impacts below the critical speed",
         e_min, a, kSaturatedBEcs / e_min, a * kSaturatedBEcs / e_min);
     return f;
+  }
+  // Standard errors: s^2 (J^T J)^-1 at the optimum, s^2 = SSR / (n - 2).
+  double jtj[2][2] = {{0, 0}, {0, 0}};
+  for (std::size_t i = 0; i < e.size(); ++i) {
+    const double x = std::exp(-b * e[i]);
+    const double g[2] = {1.0 - x, a * e[i] * x};
+    for (int p = 0; p < 2; ++p)
+      for (int q = 0; q < 2; ++q) jtj[p][q] += g[p] * g[q];
+  }
+  const double det = jtj[0][0] * jtj[1][1] - jtj[0][1] * jtj[0][1];
+  if (e.size() > 2 && det > 0.0) {
+    const double s2 = s / static_cast<double>(e.size() - 2);
+    f.a_se_percent = std::sqrt(s2 * jtj[1][1] / det);
+    f.b_se_t_per_kwh = std::sqrt(s2 * jtj[0][0] / det);
   }
   if (b * *energies.rbegin() < 0.5) {
     f.note =
