@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <sstream>
 #include <unordered_map>
 
@@ -21,6 +22,7 @@
 #include "error.h"
 #include "memory.h"
 #include "neighbor.h"
+#include "network_step.h"
 #include "step_limit.h"
 #include "style_args.h"
 #include "update.h"
@@ -205,6 +207,16 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
     } else if (key == "lanes") {
       lanes_ = args.integer(arg[iarg], val, 1, 4);
       if (lanes_ == 3) fail("lanes must be 1, 2 or 4 (intact bonds per evaluation), got 3");
+    } else if (key == "step_estimate") {
+      if (std::strcmp(val, "sum") == 0)
+        network_step_ = false;
+      else if (std::strcmp(val, "network") == 0)
+        network_step_ = true;
+      else
+        fail(
+            "step_estimate must be sum (per-atom sum of the pairs' omega^2) or network "
+            "(the whole network's largest eigenfrequency), got '" +
+            std::string(val) + "'");
     } else if (key == "break_log") {
       break_log_path_ = val;
     } else if (key == "dump_bonds") {
@@ -217,17 +229,15 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
         iarg += 2;
       }
     } else {
-      fail(
-          "unknown keyword '" + key +
-          (flat_joint_
-               ? "' (expected radius_multiplier, modulus, stiffness_ratio, "
-                 "tensile_strength, cohesion, friction_angle, elements, joint_friction, "
-                 "softening, unbonded_fraction, unbonded_seed, damping, gap, max_bonds, break_log, "
-                 "dump_bonds)"
-               : "' (expected radius_multiplier, modulus, stiffness_ratio, "
-                 "tensile_strength, cohesion, friction_angle, moment_factor, "
-                 "broken_contact, contact_moment, unbonded_fraction, unbonded_seed, "
-                 "damping, gap, max_bonds, lanes, break_log, dump_bonds)"));
+      fail("unknown keyword '" + key +
+           (flat_joint_ ? "' (expected radius_multiplier, modulus, stiffness_ratio, "
+                          "tensile_strength, cohesion, friction_angle, elements, joint_friction, "
+                          "softening, unbonded_fraction, unbonded_seed, damping, gap, max_bonds, "
+                          "step_estimate, break_log, dump_bonds)"
+                        : "' (expected radius_multiplier, modulus, stiffness_ratio, "
+                          "tensile_strength, cohesion, friction_angle, moment_factor, "
+                          "broken_contact, contact_moment, unbonded_fraction, unbonded_seed, "
+                          "damping, gap, max_bonds, lanes, step_estimate, break_log, dump_bonds)"));
     }
     iarg += 2;
   }
@@ -1335,15 +1345,20 @@ void FixBondBreakable::write_bond_dump() {
 // Critical time step of the bond springs over the bonds left now: per bond
 // the exact largest squared eigenfrequency of the free bonded pair
 // (step_limit.h, bond_omega2); an atom's estimate sums its bonds' values
-// (exact for a pair and for the axial mode of a uniform chain); velocity
-// Verlet is stable for omega dt < 2. 0 when no bond is left. Collective
-// (one reduction); caches the value for f_ID[6].
+// (exact for a pair and for the axial mode of a uniform chain), a bound of
+// the network's omega_max^2; with step_estimate network, the smaller of that
+// and the network's own largest eigenvalue (network_step.h). Velocity
+// Verlet is stable for omega dt < 2. With dashpots, the sum's step takes
+// each atom's damping of its top mode; the network's the strongest of them
+// (the top mode's damping is not known; step_limit.h). 0 when no bond is
+// left. Collective; caches the value for f_ID[6].
 double FixBondBreakable::critical_step() {
   double *radius = atom->radius, *rmass = atom->rmass;
   const mill::step_limit::BondSprings springs{modulus_, stiffness_ratio_, radius_multiplier_};
   // [0]: the largest per-atom sum of the bonds' omega^2; [1]: minus the
-  // smallest per-atom step with the dashpots (one MAX reduction for both).
-  double local[2] = {0.0, -HUGE_VAL};
+  // smallest per-atom step with the dashpots; [2]: minus the smallest
+  // per-atom share of the step the dashpots leave (one MAX reduction).
+  double local[3] = {0.0, -HUGE_VAL, -HUGE_VAL};
   for (int i = 0; i < atom->nlocal; ++i) {
     double sum2 = 0.0, sum1 = 0.0;
     for (int k = 0; k < nbond_[i]; ++k) {
@@ -1354,14 +1369,112 @@ double FixBondBreakable::critical_step() {
       sum1 += std::sqrt(w2);
     }
     local[0] = std::max(local[0], sum2);
-    if (sum2 > 0.0)
-      local[1] = std::max(local[1], -mill::step_limit::damped_critical_step(sum2, sum1, damping_));
+    if (sum2 > 0.0) {
+      const double damped = mill::step_limit::damped_critical_step(sum2, sum1, damping_);
+      local[1] = std::max(local[1], -damped);
+      local[2] = std::max(local[2], -damped / mill::step_limit::critical_step(sum2));
+    }
   }
-  double global[2] = {0.0, 0.0};
-  MPI_Allreduce(local, global, 2, MPI_DOUBLE, MPI_MAX, world);
-  dt_crit_ = mill::step_limit::critical_step(global[0]);
-  dt_crit_damped_ = global[0] > 0.0 ? -global[1] : 0.0;
+  double global[3] = {0.0, 0.0, 0.0};
+  MPI_Allreduce(local, global, 3, MPI_DOUBLE, MPI_MAX, world);
+  dt_crit_sum_ = mill::step_limit::critical_step(global[0]);
+  network_iterations_ = 0;
+  double omega2 = global[0];
+  if (network_step_ && global[0] > 0.0) omega2 = std::min(omega2, network_omega2());
+  dt_crit_ = mill::step_limit::critical_step(omega2);
+  if (global[0] <= 0.0)
+    dt_crit_damped_ = 0.0;
+  else if (network_step_)
+    dt_crit_damped_ = dt_crit_ * -global[2];
+  else
+    dt_crit_damped_ = -global[1];
   return dt_crit_;
+}
+
+// The network's largest omega^2 (network_step.h): every rank sends the bonds
+// it counts (those of the lower tag's owner) to rank 0, which orders them by
+// tags (the same estimate on any number of ranks), runs the Lanczos
+// estimate and sends the value back. Springs as in step_limit.h.
+double FixBondBreakable::network_omega2() {
+  constexpr int kCols = 10;  // tag_a tag_b mass_a mass_b radius_a radius_b l0 n
+  const int *tag = atom->tag;
+  const double *radius = atom->radius, *rmass = atom->rmass;
+  double **x = atom->x;
+  std::vector<double> mine;
+  for (int i = 0; i < atom->nlocal; ++i) {
+    for (int k = 0; k < nbond_[i]; ++k) {
+      const int ptag = static_cast<int>(bonds_[i][k * ncol_ + PARTNER]);
+      if (tag[i] > ptag) continue;  // counted by the lower tag's owner
+      const int j = partner_index(i, ptag);
+      Vec3 d = load3(x[j]) - load3(x[i]);
+      d = (1.0 / std::sqrt(dot(d, d))) * d;
+      const double rec[kCols] = {static_cast<double>(tag[i]),
+                                 static_cast<double>(ptag),
+                                 rmass[i],
+                                 rmass[j],
+                                 radius[i],
+                                 radius[j],
+                                 bonds_[i][k * ncol_ + L0],
+                                 d.x,
+                                 d.y,
+                                 d.z};
+      mine.insert(mine.end(), rec, rec + kCols);
+    }
+  }
+  const int nprocs = comm->nprocs;
+  const int count = static_cast<int>(mine.size());
+  std::vector<int> counts(nprocs), displs(nprocs, 0);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
+  std::vector<double> all;
+  if (comm->me == 0) {
+    for (int p = 1; p < nprocs; ++p) displs[p] = displs[p - 1] + counts[p - 1];
+    all.resize(static_cast<size_t>(displs[nprocs - 1]) + counts[nprocs - 1]);
+  }
+  MPI_Gatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE,
+              0, world);
+  double result[2] = {0.0, 0.0};  // omega^2, Lanczos steps
+  if (comm->me == 0) {
+    const size_t nb = all.size() / kCols;
+    std::vector<size_t> order(nb);
+    for (size_t b = 0; b < nb; ++b) order[b] = b;
+    std::sort(order.begin(), order.end(), [&](size_t p, size_t q) {
+      const double *rp = &all[p * kCols], *rq = &all[q * kCols];
+      return rp[0] != rq[0] ? rp[0] < rq[0] : rp[1] < rq[1];
+    });
+    std::map<int, int> index;  // tag -> atom of the network
+    mill::network_step::Atoms atoms;
+    auto atom_of = [&](double t, double m, double r) {
+      const auto it = index.emplace(static_cast<int>(t), static_cast<int>(atoms.mass.size()));
+      if (it.second) {
+        atoms.mass.push_back(m);
+        atoms.inertia.push_back(0.4 * m * r * r);
+      }
+      return it.first->second;
+    };
+    std::vector<mill::network_step::Bond> bonds(nb);
+    for (size_t b = 0; b < nb; ++b) {
+      const double *r = &all[order[b] * kCols];
+      mill::network_step::Bond &bd = bonds[b];
+      bd.a = atom_of(r[0], r[2], r[4]);
+      bd.b = atom_of(r[1], r[3], r[5]);
+      const double l0 = r[6], rb = radius_multiplier_ * std::min(r[4], r[5]);
+      bd.n = {r[7], r[8], r[9]};
+      bd.arm_a = l0 * r[4] / (r[4] + r[5]);
+      bd.arm_b = l0 - bd.arm_a;
+      const double kn = modulus_ / l0, ks = kn / stiffness_ratio_;
+      const double area = mill::step_limit::kPi * rb * rb, inertia = 0.25 * area * rb * rb;
+      bd.kna = kn * area;
+      bd.ksa = ks * area;
+      bd.kni = kn * inertia;
+      bd.ksj = ks * 2.0 * inertia;
+    }
+    const mill::network_step::Estimate est = mill::network_step::largest_omega2(bonds, atoms);
+    result[0] = est.omega2;
+    result[1] = est.iterations;
+  }
+  MPI_Bcast(result, 2, MPI_DOUBLE, 0, world);
+  network_iterations_ = static_cast<int>(result[1]);
+  return result[0];
 }
 
 // At the setup of a run: the critical step, printed; warns if the deck's dt
@@ -1369,6 +1482,13 @@ double FixBondBreakable::critical_step() {
 void FixBondBreakable::estimate_time_step() {
   if (critical_step() <= 0.0) return;
   char line[256];
+  if (network_step_) {
+    snprintf(line, sizeof(line),
+             "%sstep_estimate network: bonds' critical step %.4g s (%d Lanczos steps), the "
+             "per-atom sum's %.4g s",
+             label().c_str(), dt_crit_, network_iterations_, dt_crit_sum_);
+    message(line);
+  }
   if (damping_ > 0.0)
     snprintf(line, sizeof(line),
              "%scritical time step of bond springs %.4g s, %.4g s with their dashpots; time step "

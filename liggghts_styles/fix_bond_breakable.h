@@ -93,6 +93,8 @@ class FixBondBreakable : public Fix {
   // and f_ID[8] the same with the dashpots (damped_critical_step).
   // Collective: every rank calls it at the same step.
   double critical_step();
+  // Lanczos steps the last network estimate took (0: step_estimate sum).
+  int network_iterations() const { return network_iterations_; }
 
  private:
   // "fix <style>: ", the start of every message.
@@ -126,6 +128,9 @@ class FixBondBreakable : public Fix {
   std::string dump_bonds_path_;
   int dump_every_ = 0;
   int lanes_ = 2;  // intact bonds evaluated at once (1, 2, 4; bond_lanes.h)
+  // step_estimate network: the critical step from the whole network's largest
+  // eigenfrequency (network_step.h) instead of the per-atom sum alone.
+  bool network_step_ = false;
   // Intact-bond evaluations on this rank since the fix was defined: in packs
   // of lanes, and one at a time (output 7).
   double evals_packed_ = 0.0, evals_single_ = 0.0;
@@ -140,6 +145,11 @@ class FixBondBreakable : public Fix {
   double energy_ = 0.0;
   double dt_crit_ = 0.0;
   double dt_crit_damped_ = 0.0;  // with the dashpots (f_ID[8]); dt_crit_ when damping is 0
+  double dt_crit_sum_ = 0.0;     // the per-atom sum's step (dt_crit_ with step_estimate sum)
+  int network_iterations_ = 0;
+  // step_estimate network: this rank's bonds to rank 0, the estimate back
+  // (collective); the largest omega^2 [1/s^2], 0 when no bond is left.
+  double network_omega2();
 
   // Per-atom storage.
   int nmax_ = 0;

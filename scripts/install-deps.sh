@@ -6,7 +6,7 @@ PKGS="build-essential cmake pkg-config git
   liggghts libliggghts-dev
   openfoam
   openmpi-bin libopenmpi-dev
-  libvtk9-dev libhdf5-dev
+  libvtk9-dev libhdf5-dev libeigen3-dev
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev libgtest-dev
   slurm-wlm munge
   python3 python3-matplotlib python3-numpy python3-h5py python3-pil

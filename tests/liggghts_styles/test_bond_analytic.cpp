@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "bond_test_util.h"
+#include "network_step.h"
 
 using namespace mill_test;
 
@@ -715,6 +716,126 @@ TEST(BondTimeStep, ExactStepIsTheStabilityLimit) {
     EXPECT_GT(unstable, 100.0);  // bound: blows up
     EXPECT_LT(stable, 10.0);     // bound: Verlet energy error stays bounded
   }
+}
+
+// ===========================================================================
+// 8b. step_estimate network: the critical step of the whole bonded network
+//    (network_step.h). A free 3 x 3 x 3 cluster (jittered cubic lattice,
+//    54 bonds) reports f_ID[6] = 2 / sqrt(omega^2) of network_step's
+//    estimate on the same bonds within 1e-4 (what the fix hands over; each
+//    estimate is within its tolerance, 1e-4, above the true omega^2, and the
+//    atoms' order sets the start vector), the same on 2 ranks (split
+//    through the cluster) to round-off, and longer than the
+//    per-atom sum's (step_estimate sum). The step is the real limit: with
+//    small random velocities and spins the cluster blows up at 1.2 x it
+//    (energy x > 100 within 12 steps) and not at 0.8 x it (x < 10 over
+//    2000 steps).
+// ===========================================================================
+namespace {
+
+std::vector<Sphere> jittered_cluster() {
+  Lcg rnd{4242u};
+  std::vector<Sphere> atoms;
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) {
+        Sphere s;
+        s.x = {(i - 1) * kL0 + 4e-5 * rnd(), (j - 1) * kL0 + 4e-5 * rnd(),
+               (k - 1) * kL0 + 4e-5 * rnd()};
+        for (int c = 0; c < 3; ++c) {
+          s.v[c] = 1e-4 * rnd();
+          s.w[c] = 0.1 * rnd();
+        }
+        atoms.push_back(s);
+      }
+  return atoms;
+}
+
+// network_step's estimate for the cluster's bonds (surface gap < kGap kR:
+// the lattice neighbours), springs as the fix makes them.
+double cluster_network_omega2(const std::vector<Sphere> &atoms) {
+  std::vector<mill::network_step::Bond> bonds;
+  mill::network_step::Atoms net;
+  for (const auto &s : atoms) {
+    net.mass.push_back(sphere_mass(s.r));
+    net.inertia.push_back(sphere_inertia(s.r));
+  }
+  for (size_t a = 0; a < atoms.size(); ++a)
+    for (size_t b = a + 1; b < atoms.size(); ++b) {
+      double d[3], len = 0.0;
+      for (int c = 0; c < 3; ++c) {
+        d[c] = atoms[b].x[c] - atoms[a].x[c];
+        len += d[c] * d[c];
+      }
+      len = std::sqrt(len);
+      if (len - atoms[a].r - atoms[b].r >= kGap * std::min(atoms[a].r, atoms[b].r)) continue;
+      mill::network_step::Bond bd;
+      bd.a = static_cast<int>(a);
+      bd.b = static_cast<int>(b);
+      bd.n = {d[0] / len, d[1] / len, d[2] / len};
+      bd.arm_a = len * atoms[a].r / (atoms[a].r + atoms[b].r);
+      bd.arm_b = len - bd.arm_a;
+      const double kn = kEb / len, ks = kn / kRatio;
+      bd.kna = kn * kArea;
+      bd.ksa = ks * kArea;
+      bd.kni = kn * kInertia;
+      bd.ksj = ks * kPolar;
+      bonds.push_back(bd);
+    }
+  EXPECT_EQ(bonds.size(), 54u) << "the lattice's neighbours";
+  return mill::network_step::largest_omega2(bonds, net).omega2;
+}
+
+// f_ID[6] after `run 0`, and with steps > 0 the largest total energy over
+// the initial one in `steps` steps at time step dt.
+std::pair<double, double> run_cluster(const std::string &estimate, int nprocs, double dt,
+                                      int steps) {
+  const std::string dir = make_run_dir("an_net_" + estimate + std::to_string(nprocs));
+  const auto atoms = jittered_cluster();
+  std::ostringstream d;
+  d.precision(17);
+  d << "fix integr all nve/sphere\n"
+    << bond_fix("step_estimate " + estimate, 1e15, 1e15) << "compute rke all erotate/sphere\n"
+    << "variable s equal step\nvariable etot equal ke+c_rke+f_bonds[5]\n"
+    << "timestep " << (dt > 0.0 ? dt : 1e-9) << "\nrun 0\n"
+    << "variable dtc equal f_bonds[6]\nprint \"${dtc}\" file dtc.txt\n";
+  if (steps > 0)
+    d << "fix pr all print 1 \"${s} ${etot}\" file hist.txt screen no title none\n"
+      << "thermo 1000\nrun " << steps << "\n";
+  const auto r = run_with_data(dir, atoms, d.str(), 0.01, nprocs, nprocs > 1);
+  EXPECT_EQ(r.exit_code, 0) << r.screen;
+  const auto dtc = read_table(dir + "/dtc.txt");
+  const double step = dtc.empty() ? 0.0 : dtc.front()[0];
+  if (steps <= 0) return {step, 0.0};
+  const auto rows = read_table(dir + "/hist.txt");
+  EXPECT_EQ(rows.size(), static_cast<size_t>(steps));
+  double emax = 0.0;
+  for (const auto &row : rows) emax = std::max(emax, row[1]);
+  return {step, emax / kinetic_energy(atoms)};  // bonds unloaded at the start
+}
+
+}  // namespace
+
+TEST(BondTimeStep, NetworkStepIsTheClustersLimit) {
+  const double want = 2.0 / std::sqrt(cluster_network_omega2(jittered_cluster()));
+  const double net1 = run_cluster("network", 1, 0.0, 0).first;
+  const double net2 = run_cluster("network", 2, 0.0, 0).first;
+  const double sum = run_cluster("sum", 1, 0.0, 0).first;
+  std::printf(
+      "cluster of 27, 54 bonds: f_ID[6] network %.9e s (2 ranks %.9e s), network_step %.9e s, "
+      "per-atom sum %.6e s (network x %.3f)\n",
+      net1, net2, want, sum, net1 / sum);
+  EXPECT_NEAR(net1 / want, 1.0, 1e-4);
+  EXPECT_NEAR(net2 / net1, 1.0, 1e-12);
+  EXPECT_GT(net1, 1.05 * sum);  // the sum bounds omega^2 from above: a shorter step
+  const double unstable = run_cluster("network", 1, 1.2 * net1, 12).second;
+  const double stable = run_cluster("network", 1, 0.8 * net1, 2000).second;
+  std::printf(
+      "max E/E0: %.3e at 1.2 x the network step (12 steps, must be > 100), %.3f at 0.8 x (2000 "
+      "steps, must be < 10)\n",
+      unstable, stable);
+  EXPECT_GT(unstable, 100.0);
+  EXPECT_LT(stable, 10.0);
 }
 
 // ===========================================================================

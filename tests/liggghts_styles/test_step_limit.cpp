@@ -12,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "network_step.h"
 #include "step_limit.h"
 
 namespace {
@@ -324,4 +325,129 @@ TEST(StepLimit, DampedCriticalStepOfEqualBondsGrowsTheDampingWithTheirNumber) {
             0.5 * mill::step_limit::critical_step(18 * w * w));
   EXPECT_GT(mill::step_limit::damped_critical_step(6 * w * w, 6 * w, d),
             0.5 * mill::step_limit::critical_step(6 * w * w));
+}
+
+// ---------------------------------------------------------------------------
+// The network's own largest eigenfrequency (network_step.h, fix
+// bond/breakable's `step_estimate network`): the Lanczos estimate against
+// the dense eigenvalue of the assembled network above (Jacobi, built from
+// the springs' strain vectors, not from network_step's force law) and
+// against closed forms.
+// ---------------------------------------------------------------------------
+namespace {
+
+// The hand-built bonds as network_step sees them (as the fix hands them over).
+mill::network_step::Bond to_network_bond(const BondSprings &s, const std::vector<Sphere> &sp,
+                                         const Bond &b) {
+  const Sphere &a = sp[b.i], &c = sp[b.j];
+  double d[3], l0 = 0.0;
+  for (int q = 0; q < 3; ++q) {
+    d[q] = c.x[q] - a.x[q];
+    l0 += d[q] * d[q];
+  }
+  l0 = std::sqrt(l0);
+  mill::network_step::Bond nb;
+  nb.a = b.i;
+  nb.b = b.j;
+  nb.n = {d[0] / l0, d[1] / l0, d[2] / l0};
+  nb.arm_a = l0 * a.r / (a.r + c.r);
+  nb.arm_b = l0 - nb.arm_a;
+  const double rb = s.radius_multiplier * std::min(a.r, c.r);
+  const double area = kPi * rb * rb, inertia = 0.25 * area * rb * rb;
+  const double kn = s.modulus / l0, ks = kn / s.stiffness_ratio;
+  nb.kna = kn * area;
+  nb.ksa = ks * area;
+  nb.kni = kn * inertia;
+  nb.ksj = ks * 2.0 * inertia;
+  return nb;
+}
+
+mill::network_step::Estimate lanczos(const BondSprings &s, const std::vector<Sphere> &sp,
+                                     const std::vector<Bond> &bonds) {
+  std::vector<mill::network_step::Bond> nb;
+  for (const Bond &b : bonds) nb.push_back(to_network_bond(s, sp, b));
+  mill::network_step::Atoms atoms;
+  for (const Sphere &x : sp) {
+    atoms.mass.push_back(x.m);
+    atoms.inertia.push_back(0.4 * x.m * x.r * x.r);
+  }
+  return mill::network_step::largest_omega2(nb, atoms);
+}
+
+}  // namespace
+
+// One pair: the Ritz value is the closed form of the pair within 1e-7 (its
+// error is of the order of the residual^2 / the spectral gap: (1e-4)^2
+// relative here) and the estimate (Ritz value + residual) at most the iteration's
+// tolerance (1e-4) above it, not below.
+TEST(NetworkStep, OnePairIsThePairsClosedForm) {
+  const Lump l = hand_built_lump();
+  for (const Bond &b : l.bonds) {
+    const Sphere &a = l.spheres[b.i], &c = l.spheres[b.j];
+    double l0 = 0.0;
+    for (int q = 0; q < 3; ++q) l0 += (c.x[q] - a.x[q]) * (c.x[q] - a.x[q]);
+    const double closed =
+        mill::step_limit::bond_omega2(l.springs, {a.r, c.r, a.m, c.m, std::sqrt(l0)});
+    const auto est = lanczos(l.springs, l.spheres, {b});
+    EXPECT_NEAR(est.ritz / closed, 1.0, 1e-7) << "bond " << b.i << "-" << b.j;
+    EXPECT_GE(est.omega2, closed * (1.0 - 1e-12)) << "bond " << b.i << "-" << b.j;
+    EXPECT_LE(est.omega2, closed * (1.0 + 1e-4)) << "bond " << b.i << "-" << b.j;
+  }
+}
+
+// The hand-built lump: the Ritz value is the dense network eigenvalue within
+// 1e-6, the estimate not below it and at most the iteration's tolerance
+// (1e-4) above, and below the per-atom sum, which it replaces; the step it
+// gives is the longer one.
+TEST(NetworkStep, LumpMatchesTheDenseEigenvalue) {
+  const Lump l = hand_built_lump();
+  const double dense = network_omega2(l.springs, l.spheres, l.bonds);
+  const auto est = lanczos(l.springs, l.spheres, l.bonds);
+  const double dt_sum = fix_critical_step(l.springs, l.spheres, l.bonds);
+  const double dt_net = mill::step_limit::critical_step(est.omega2);
+  std::printf(
+      "%zu bonds: omega^2 dense %.9e, Lanczos %.9e (Ritz %.9e + residual %.3e, %d steps); step "
+      "network %.4e s, per-atom sum %.4e s (x %.3f)\n",
+      l.bonds.size(), dense, est.omega2, est.ritz, est.residual, est.iterations, dt_net, dt_sum,
+      dt_net / dt_sum);
+  EXPECT_NEAR(est.ritz / dense, 1.0, 1e-6);
+  EXPECT_LE(est.ritz, dense * (1.0 + 1e-12));    // the Ritz value never above
+  EXPECT_GE(est.omega2, dense * (1.0 - 1e-12));  // an upper estimate
+  EXPECT_LE(est.omega2, dense * (1.0 + 1e-4));   // within the tolerance
+  EXPECT_GT(dt_net, dt_sum);                     // the sum bounds omega^2 from above
+}
+
+// A free chain of n equal spheres along x with stiff axial and soft shear
+// springs (kn/ks 1000): its top mode is axial, omega^2 = 2 kn A / m (1 +
+// cos(pi / n)) (the free-free chain of masses and springs), against the
+// per-atom sum's 4 kn A / m. Ritz value within 1e-6; the estimate at most
+// the iteration's tolerance (1e-4) above the closed form, not below.
+TEST(NetworkStep, ChainIsTheClosedFormOfItsAxialMode) {
+  const BondSprings springs{50e9, 1000.0, 1.0};
+  const double r = 1e-3, len = 2.05e-3;
+  for (const int n : {2, 5, 20}) {
+    std::vector<Sphere> sp(n);
+    std::vector<Bond> bonds;
+    for (int k = 0; k < n; ++k) {
+      sp[k].r = r;
+      sp[k].m = 2580.0 * 4.0 / 3.0 * kPi * r * r * r;
+      sp[k].x[0] = k * len;
+      sp[k].x[1] = sp[k].x[2] = 0.0;
+      if (k > 0) bonds.push_back({k - 1, k});
+    }
+    const double kna = springs.modulus / len * kPi * r * r;
+    const double closed = 2.0 * kna / sp[0].m * (1.0 + std::cos(kPi / n));
+    const auto est = lanczos(springs, sp, bonds);
+    std::printf("chain of %d: omega^2 %.9e, closed form %.9e (%d Lanczos steps)\n", n, est.omega2,
+                closed, est.iterations);
+    EXPECT_NEAR(est.ritz / closed, 1.0, 1e-6) << n << " spheres";
+    EXPECT_GE(est.omega2, closed * (1.0 - 1e-12)) << n << " spheres";
+    EXPECT_LE(est.omega2, closed * (1.0 + 1e-4)) << n << " spheres";
+  }
+}
+
+// No bond: no bound.
+TEST(NetworkStep, NoBondGivesZero) {
+  mill::network_step::Atoms atoms{{1.0, 1.0}, {1.0, 1.0}};
+  EXPECT_EQ(mill::network_step::largest_omega2({}, atoms).omega2, 0.0);
 }

@@ -63,7 +63,7 @@ nlohmann::json impact_base_inputs(const StageContext& ctx) {
   // Bumped whenever the impact deck or the bond style changes what a run
   // gives (git log of this line: what each version changed); results of
   // other versions are not comparable.
-  base["deck_version"] = 7;
+  base["deck_version"] = 8;
   return base;
 }
 
