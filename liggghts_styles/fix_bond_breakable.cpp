@@ -1348,17 +1348,18 @@ void FixBondBreakable::write_bond_dump() {
 // (exact for a pair and for the axial mode of a uniform chain), a bound of
 // the network's omega_max^2; with step_estimate network, the smaller of that
 // and the network's own largest eigenvalue (network_step.h). Velocity
-// Verlet is stable for omega dt < 2. With dashpots, the sum's step takes
-// each atom's damping of its top mode; the network's the strongest of them
-// (the top mode's damping is not known; step_limit.h). 0 when no bond is
-// left. Collective; caches the value for f_ID[6].
+// Verlet is stable for omega dt < 2. With dashpots (f_ID[8]) the step stays
+// the per-atom estimate, each atom's sum with its damping, whatever
+// step_estimate: the damping of the network's top mode is not known, and
+// the network's step scaled by the strongest per-atom damping created
+// energy in the lab decks (docs/styles/fix_bond_breakable.md). 0 when no
+// bond is left. Collective; caches the value for f_ID[6].
 double FixBondBreakable::critical_step() {
   double *radius = atom->radius, *rmass = atom->rmass;
   const mill::step_limit::BondSprings springs{modulus_, stiffness_ratio_, radius_multiplier_};
   // [0]: the largest per-atom sum of the bonds' omega^2; [1]: minus the
-  // smallest per-atom step with the dashpots; [2]: minus the smallest
-  // per-atom share of the step the dashpots leave (one MAX reduction).
-  double local[3] = {0.0, -HUGE_VAL, -HUGE_VAL};
+  // smallest per-atom step with the dashpots (one MAX reduction for both).
+  double local[2] = {0.0, -HUGE_VAL};
   for (int i = 0; i < atom->nlocal; ++i) {
     double sum2 = 0.0, sum1 = 0.0;
     for (int k = 0; k < nbond_[i]; ++k) {
@@ -1369,25 +1370,17 @@ double FixBondBreakable::critical_step() {
       sum1 += std::sqrt(w2);
     }
     local[0] = std::max(local[0], sum2);
-    if (sum2 > 0.0) {
-      const double damped = mill::step_limit::damped_critical_step(sum2, sum1, damping_);
-      local[1] = std::max(local[1], -damped);
-      local[2] = std::max(local[2], -damped / mill::step_limit::critical_step(sum2));
-    }
+    if (sum2 > 0.0)
+      local[1] = std::max(local[1], -mill::step_limit::damped_critical_step(sum2, sum1, damping_));
   }
-  double global[3] = {0.0, 0.0, 0.0};
-  MPI_Allreduce(local, global, 3, MPI_DOUBLE, MPI_MAX, world);
+  double global[2] = {0.0, 0.0};
+  MPI_Allreduce(local, global, 2, MPI_DOUBLE, MPI_MAX, world);
   dt_crit_sum_ = mill::step_limit::critical_step(global[0]);
   network_iterations_ = 0;
   double omega2 = global[0];
   if (network_step_ && global[0] > 0.0) omega2 = std::min(omega2, network_omega2());
   dt_crit_ = mill::step_limit::critical_step(omega2);
-  if (global[0] <= 0.0)
-    dt_crit_damped_ = 0.0;
-  else if (network_step_)
-    dt_crit_damped_ = dt_crit_ * -global[2];
-  else
-    dt_crit_damped_ = -global[1];
+  dt_crit_damped_ = global[0] > 0.0 ? -global[1] : 0.0;
   return dt_crit_;
 }
 

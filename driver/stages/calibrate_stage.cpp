@@ -52,9 +52,7 @@ using namespace calibrate;
 // and a disc that does not split gives none. 11: the triaxial deck presses
 // only the shell elements held by a bond or a contact (a loose one was
 // pushed across the open end face until the energy ledger stopped the run).
-// 12: the lab decks' bonds take the whole network's critical step
-// (step_estimate network: 1.3-1.5 x the per-atom bound's).
-constexpr int kDeckVersion = 12;
+constexpr int kDeckVersion = 11;
 
 // The fit's targets: the card's four macro properties, and its K_IC when
 // the fit aims at it.
