@@ -566,6 +566,15 @@ void check_physics(const Document& d) {
   }
   check_unique_items(d, "rotor.rpm", "rpm");
   check_unique_items(d, "breakage.velocities", "m/s");
+  if (d.has("breakage.strength_velocities")) {
+    check_unique_items(d, "breakage.strength_velocities", "m/s");
+    if (d.str("breakage.conditions") != "transport")
+      throw ConfigError(fmt::format(
+          "{}: strength impacts go beside stage 1's impact conditions, and breakage.conditions is "
+          "sweep; expected it absent (list the speeds in breakage.velocities) or "
+          "breakage.conditions: transport",
+          d.where("breakage.strength_velocities")));
+  }
   check_unique_items(d, "breakage.angles", "deg");
 
   // The lump against the beaters: a plate reaches (D - hub) / 2 from the hub.
@@ -670,11 +679,21 @@ void check_job_count(const Document& d) {
   } else {
     const double bins = static_cast<double>(d.integer("breakage.velocity_bins"));
     const double lumps = static_cast<double>(d.integer("breakage.in_mill.lumps"));
-    jobs = rpms * (bins * repeats + lumps);
-    how = fmt::format("rotor.rpm ({}) x (breakage.velocity_bins ({}) x breakage.repeats ({}) + breakage.in_mill.lumps ({}))",
-                      rpms, bins, repeats, lumps);
-    factors = {{"breakage.velocity_bins", bins}, {"breakage.repeats", repeats}, {"breakage.in_mill.lumps", lumps},
-               {"rotor.rpm", rpms}};
+    const double strength =
+        d.has("breakage.strength_velocities")
+            ? static_cast<double>(d.reals("breakage.strength_velocities").size())
+            : 0;
+    jobs = rpms * (bins * repeats + lumps) + strength * repeats;
+    how = fmt::format(
+        "rotor.rpm ({}) x (breakage.velocity_bins ({}) x breakage.repeats ({}) + "
+        "breakage.in_mill.lumps ({}))"
+        " + breakage.strength_velocities ({}) x breakage.repeats",
+        rpms, bins, repeats, lumps, strength);
+    factors = {{"breakage.velocity_bins", bins},
+               {"breakage.repeats", repeats},
+               {"breakage.in_mill.lumps", lumps},
+               {"rotor.rpm", rpms},
+               {"breakage.strength_velocities", strength}};
   }
   if (jobs <= kMaxJobs) return;
   const auto largest = std::max_element(factors.begin(), factors.end(),

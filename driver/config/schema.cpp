@@ -343,105 +343,114 @@ std::vector<KeyDef> lump_keys() {
 
 // The breakage stage: its sweep or transport conditions, and the in-mill runs.
 std::vector<KeyDef> breakage_keys() {
-  return {// --- breakage sweep (stage 2) ---
-          choice("breakage.conditions", "sweep", {"sweep", "transport"},
-                 "sweep: the velocities/angles below; transport: binned from stage 1 impacts"),
-          range(key("breakage.velocities", T::RealList, "m/s",
-                    "[4, 10, 20, 40, 60, 80, 100, 120, 150, 169]",
-                    "Impact speeds of the sweep (beater mills reach 50-150 m/s; above 500 m/s a "
-                    "rock lump is a shock "
-                    "problem the bond model does not describe)"),
-                0, true, 500, false),
-          range(key("breakage.angles", T::RealList, "deg", "[90]",
-                    "Impact angles to the surface (90 = normal)"),
-                0, true, 90, false),
-          at_least(key("breakage.repeats", T::Int, "", "1",
-                       "Repeats per condition (random orientation)"),
-                   1),
-          positive(key("breakage.duration_after_contact", T::Real, "s", "6e-3",
-                       "Simulated time after first contact, at most")),
-          at_least(key("breakage.quiet_time", T::Real, "s", "1e-3",
-                       "Stop earlier once no bond broke for this long after contact; 0 = always "
-                       "the full duration"),
+  return {
+      // --- breakage sweep (stage 2) ---
+      choice("breakage.conditions", "sweep", {"sweep", "transport"},
+             "sweep: the velocities/angles below; transport: binned from stage 1 impacts"),
+      range(key("breakage.velocities", T::RealList, "m/s",
+                "[4, 10, 20, 40, 60, 80, 100, 120, 150, 169]",
+                "Impact speeds of the sweep (beater mills reach 50-150 m/s; above 500 m/s a "
+                "rock lump is a shock "
+                "problem the bond model does not describe)"),
+            0, true, 500, false),
+      range(key("breakage.angles", T::RealList, "deg", "[90]",
+                "Impact angles to the surface (90 = normal)"),
+            0, true, 90, false),
+      at_least(
+          key("breakage.repeats", T::Int, "", "1", "Repeats per condition (random orientation)"),
+          1),
+      positive(key("breakage.duration_after_contact", T::Real, "s", "6e-3",
+                   "Simulated time after first contact, at most")),
+      at_least(key("breakage.quiet_time", T::Real, "s", "1e-3",
+                   "Stop earlier once no bond broke for this long after contact; 0 = always "
+                   "the full duration"),
+               0),
+      at_least(key("breakage.timestep", T::Real, "s", "0",
+                   "Time step; 0 = automatic from the stability limit"),
+               0),
+      key("breakage.adaptive_step", T::Bool, "", "true",
+          "With the automatic time step (breakage.timestep: 0), re-evaluate it at the end of "
+          "each 0.25 ms chunk of an impact or in-mill run from the bonds left: half the "
+          "critical step of the remaining bonds, at most the contacts' and the speed's bound "
+          "and twice the step before (fix step/adaptive, docs/styles/fix_step_adaptive.md). "
+          "The step grows once the lump has shattered; bench/README.md, \"Adaptive time "
+          "step\", measures what it gains and that the results agree with the fixed step's "
+          "within the repeats' spread; false = one step for the whole run (so is a given "
+          "breakage.timestep)"),
+      at_least(key("breakage.dump_interval", T::Real, "s", "5e-4",
+                   "VTK dump interval in simulated time (with breakage.adaptive_step the "
+                   "dumps stay at it as the step changes); 0 = no dumps"),
+               0),
+      range(key("breakage.size_fraction_edges", T::RealList, "",
+                "[0, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.85, 1.0]",
+                "Edges of the size fractions, piece diameter / lump diameter (ascending)"),
+            0, false, 1, false),
+      range(key("breakage.critical_largest_fraction", T::Real, "", "0.05",
+                "Critical velocity: largest piece mass fraction falls below this"),
+            0, true, 1, true),
+      at_least(key("breakage.velocity_bins", T::Int, "", "5",
+                   "transport conditions: bins of impact normal speed"),
+               1),
+      key("breakage.include_wall_impacts", T::Bool, "", "false",
+          "transport conditions: also wall impacts"),
+      opt(range(key("breakage.strength_velocities", T::RealList, "m/s", "",
+                    "transport conditions: normal single impacts at these speeds beside stage "
+                    "1's, breakage.repeats each, that measure the lump's strength where the "
+                    "mill's impacts do not reach (below them): the critical impact speed and "
+                    "the JK fit read them with the mill's impacts, the mill's product does "
+                    "not (docs/breakage.md, \"Strength impacts\"); absent = none"),
+                0, true, 500, false)),
+      default_if(
+          at_least(key("breakage.in_mill.lumps", T::Int, "", "0",
+                       "In-mill breakage (needs conditions: transport): lumps per rotor speed "
+                       "(and feed class) run as bonded lumps in the turning mill from stage 1's "
+                       "first flywheel strikes, chosen spread over the strike speeds; 0 = none. "
+                       "The default 4 gives the product and the decision a band (a bootstrap "
+                       "over the lumps; bench/README.md, \"Feed to product\")"),
                    0),
-          at_least(key("breakage.timestep", T::Real, "s", "0",
-                       "Time step; 0 = automatic from the stability limit"),
-                   0),
-          key("breakage.adaptive_step", T::Bool, "", "true",
-              "With the automatic time step (breakage.timestep: 0), re-evaluate it at the end of "
-              "each 0.25 ms chunk of an impact or in-mill run from the bonds left: half the "
-              "critical step of the remaining bonds, at most the contacts' and the speed's bound "
-              "and twice the step before (fix step/adaptive, docs/styles/fix_step_adaptive.md). "
-              "The step grows once the lump has shattered; bench/README.md, \"Adaptive time "
-              "step\", measures what it gains and that the results agree with the fixed step's "
-              "within the repeats' spread; false = one step for the whole run (so is a given "
-              "breakage.timestep)"),
-          at_least(key("breakage.dump_interval", T::Real, "s", "5e-4",
-                       "VTK dump interval in simulated time (with breakage.adaptive_step the "
-                       "dumps stay at it as the step changes); 0 = no dumps"),
-                   0),
-          range(key("breakage.size_fraction_edges", T::RealList, "",
-                    "[0, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.85, 1.0]",
-                    "Edges of the size fractions, piece diameter / lump diameter (ascending)"),
-                0, false, 1, false),
-          range(key("breakage.critical_largest_fraction", T::Real, "", "0.05",
-                    "Critical velocity: largest piece mass fraction falls below this"),
-                0, true, 1, true),
-          at_least(key("breakage.velocity_bins", T::Int, "", "5",
-                       "transport conditions: bins of impact normal speed"),
-                   1),
-          key("breakage.include_wall_impacts", T::Bool, "", "false",
-              "transport conditions: also wall impacts"),
-          default_if(at_least(key("breakage.in_mill.lumps", T::Int, "", "0",
-                                  "In-mill breakage (needs conditions: transport): lumps per rotor speed "
-                                  "(and feed class) run as bonded lumps in the turning mill from stage 1's "
-                                  "first flywheel strikes, chosen spread over the strike speeds; 0 = none. "
-                                  "The default 4 gives the product and the decision a band (a bootstrap "
-                                  "over the lumps; bench/README.md, \"Feed to product\")"),
-                              0),
-                     "breakage.conditions", "transport", "4"),
-          positive(key("breakage.in_mill.duration", T::Real, "s", "0.02",
-                       "In-mill breakage: simulated time of each run, from lead_time before the "
-                       "strike (long enough for "
-                       "the fragments' first housing impacts)")),
-          positive(key("breakage.in_mill.lead_time", T::Real, "s", "2e-3",
-                       "In-mill breakage: a run starts this long before the lump's first flywheel "
-                       "strike (its state "
-                       "backed off ballistically from the strike)")),
-          key("breakage.in_mill.gas", T::Bool, "", "true",
-              "In-mill breakage: gas drag on each element from the sampled field (sample stage); "
-              "false = no gas"),
-          key("breakage.in_mill.early_stop", T::Bool, "", "true",
-              "In-mill breakage: end a run before duration, at the end of a 0.25 ms chunk, once "
-              "the strike is over: an element has touched the flywheel or the housing, no "
-              "element is within the tip radius plus one lump diameter of the axis (nor gets "
-              "there within a chunk at its speed towards the axis), and every element whose "
-              "latest flywheel contact came after its latest housing contact has left the "
-              "housing (docs/breakage.md); false = every run lasts duration"),
-          key("breakage.in_mill.skip_free_flight", T::Bool, "", "true",
-              "In-mill breakage: start the engine run where the lump's free flight ends, not "
-              "lead_time before the strike: until an element touches a surface the lump moves as "
-              "one rigid body along the ballistic path its start was backed off along, so the "
-              "run starts once its bounding sphere is within half its radius of the housing or "
-              "the turning flywheel (the skipped time is in_mill.json's "
-              "start.free_flight_skipped_s; docs/breakage.md); false = the whole lead time is "
-              "simulated"),
-          key("breakage.in_mill.animate", T::Bool, "", "true",
-              "In-mill breakage: the first in-mill run (the first lump of the first rotor speed) "
-              "also writes 60 frames over duration, drawn as an animation in the report "
-              "(breakage/animation/, docs/report.md); false = none (that run keeps the job id "
-              "it had without the frames)"),
-          at_least(key("breakage.in_mill.neighbour_bins", T::Int, "", "500000",
-                       "In-mill breakage: most neighbour bins over the simulation box, which holds "
-                       "the whole mill "
-                       "(LIGGGHTS clears every bin at each list build and walks every bin of "
-                       "each turning flywheel facet's box); the bins start at the "
-                       "larger of 4 mean element "
-                       "radii and (box volume / this)^(1/3) and grow as the fragments spread "
-                       "(bench/README.md, \"In-mill neighbour bins\": 500 000 costs 15-28 % "
-                       "less than 4 000 000 for lumps of 200-1700 elements, 23 % over the "
-                       "3344-element reference lump's 20 ms)"),
-                   1000)};
+          "breakage.conditions", "transport", "4"),
+      positive(key("breakage.in_mill.duration", T::Real, "s", "0.02",
+                   "In-mill breakage: simulated time of each run, from lead_time before the "
+                   "strike (long enough for "
+                   "the fragments' first housing impacts)")),
+      positive(key("breakage.in_mill.lead_time", T::Real, "s", "2e-3",
+                   "In-mill breakage: a run starts this long before the lump's first flywheel "
+                   "strike (its state "
+                   "backed off ballistically from the strike)")),
+      key("breakage.in_mill.gas", T::Bool, "", "true",
+          "In-mill breakage: gas drag on each element from the sampled field (sample stage); "
+          "false = no gas"),
+      key("breakage.in_mill.early_stop", T::Bool, "", "true",
+          "In-mill breakage: end a run before duration, at the end of a 0.25 ms chunk, once "
+          "the strike is over: an element has touched the flywheel or the housing, no "
+          "element is within the tip radius plus one lump diameter of the axis (nor gets "
+          "there within a chunk at its speed towards the axis), and every element whose "
+          "latest flywheel contact came after its latest housing contact has left the "
+          "housing (docs/breakage.md); false = every run lasts duration"),
+      key("breakage.in_mill.skip_free_flight", T::Bool, "", "true",
+          "In-mill breakage: start the engine run where the lump's free flight ends, not "
+          "lead_time before the strike: until an element touches a surface the lump moves as "
+          "one rigid body along the ballistic path its start was backed off along, so the "
+          "run starts once its bounding sphere is within half its radius of the housing or "
+          "the turning flywheel (the skipped time is in_mill.json's "
+          "start.free_flight_skipped_s; docs/breakage.md); false = the whole lead time is "
+          "simulated"),
+      key("breakage.in_mill.animate", T::Bool, "", "true",
+          "In-mill breakage: the first in-mill run (the first lump of the first rotor speed) "
+          "also writes 60 frames over duration, drawn as an animation in the report "
+          "(breakage/animation/, docs/report.md); false = none (that run keeps the job id "
+          "it had without the frames)"),
+      at_least(key("breakage.in_mill.neighbour_bins", T::Int, "", "500000",
+                   "In-mill breakage: most neighbour bins over the simulation box, which holds "
+                   "the whole mill "
+                   "(LIGGGHTS clears every bin at each list build and walks every bin of "
+                   "each turning flywheel facet's box); the bins start at the "
+                   "larger of 4 mean element "
+                   "radii and (box volume / this)^(1/3) and grow as the fragments spread "
+                   "(bench/README.md, \"In-mill neighbour bins\": 500 000 costs 15-28 % "
+                   "less than 4 000 000 for lumps of 200-1700 elements, 23 % over the "
+                   "3344-element reference lump's 20 ms)"),
+               1000)};
 }
 
 // A size of the feed or the product in mm, with its plausible range.

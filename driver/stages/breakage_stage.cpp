@@ -87,6 +87,27 @@ void plan_sweep(const StageContext& ctx, const nlohmann::json& base, Plan& p) {
       }
 }
 
+// With transport conditions, the strength impacts
+// (breakage.strength_velocities): normal single impacts at each speed,
+// breakage.repeats each, beside stage 1's; labelled strength_<impact>.
+void plan_strength(const StageContext& ctx, const nlohmann::json& base, Plan& p) {
+  const auto& d = ctx.cfg.doc;
+  if (!d.has("breakage.strength_velocities")) return;
+  for (double v : d.reals("breakage.strength_velocities"))
+    for (long r = 0; r < d.integer("breakage.repeats"); ++r) {
+      engine::throw_if_interrupted();
+      nlohmann::json in = base;
+      in["velocity"] = v;
+      in["angle"] = 90.0;
+      in["repeat"] = static_cast<int>(r);
+      in["strength"] = true;
+      p.jobs.push_back(
+          {std::string(kStrengthPrefix) + impact_label(v, 90.0, static_cast<int>(r)), in,
+           fmt::format("strength impact: {}-element lump at {:g} m/s, 90 deg, repeat {}",
+                       d.integer("lump.n_elements"), v, r)});
+    }
+}
+
 // With a feed: the breakage matrix per rotor speed from the in-mill runs and
 // the closed circuit's steady state, or a warning that says what the
 // population balance needs.
@@ -206,6 +227,7 @@ Plan BreakageStage::plan(const StageContext& ctx) const {
         for (const auto& c : classes)
           if (c.in_mill) plan_in_mill(ctx, rpm, p, &c);
       }
+    plan_strength(ctx, base, p);
   }
   // The same impacts with every further calibration set (calibrate.starts).
   plan_calibration_sets(ctx, p);
@@ -257,7 +279,11 @@ void BreakageStage::finalize(StageContext& ctx, const std::vector<JobSpec>& all_
       for (const auto& j : class_runs)
         if (in_mill_class(j) == lc) lump_runs.push_back(j);
     }
-    write_mill_product(ctx, jobs, write_in_mill_results(ctx, lump_runs));
+    // The strength impacts are no mill condition: the product reads stage 1's bins only.
+    std::vector<JobSpec> binned;
+    for (const auto& j : jobs)
+      if (!is_strength_job(j)) binned.push_back(j);
+    write_mill_product(ctx, binned, write_in_mill_results(ctx, lump_runs));
   }
   // lump.diameter's runs measure its class only where it has none of its
   // own (collect_measuring_runs); the class runs are passed as they are.

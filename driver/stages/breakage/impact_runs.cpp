@@ -67,6 +67,10 @@ nlohmann::json impact_base_inputs(const StageContext& ctx) {
   return base;
 }
 
+bool is_strength_job(const JobSpec& job) {
+  return job.inputs.contains("strength") && job.inputs.at("strength").get<bool>();
+}
+
 nlohmann::json impact_inputs(const StageContext& ctx, double velocity, double angle, int repeat) {
   nlohmann::json in = impact_base_inputs(ctx);
   in["velocity"] = velocity;

@@ -20,6 +20,12 @@ nlohmann::json impact_base_inputs(const StageContext& ctx);
 // inputs and the condition.
 nlohmann::json impact_inputs(const StageContext& ctx, double velocity, double angle, int repeat);
 
+// The strength impacts of a case with transport conditions
+// (breakage.strength_velocities): their labels start with kStrengthPrefix and
+// their inputs carry "strength": true; the mill's product does not read them.
+inline constexpr const char* kStrengthPrefix = "strength_";
+bool is_strength_job(const JobSpec& job);
+
 // The outputs run_impact writes into `dir` exist and parse: "" or the reason.
 std::string damaged_impact_outputs(const std::filesystem::path& dir);
 
