@@ -25,17 +25,9 @@ double norm(const std::vector<double> &v) {
   return std::sqrt(s);
 }
 
-}  // namespace
-
-// The energy of a bond is kn A dn^2 / 2 + ks A |dt|^2 / 2 + kn I |wt|^2 / 2 +
-// ks J wn^2 / 2 with d the relative displacement of b's face at the contact
-// point against a's, d = u_b - u_a + arm_a n x th_a + arm_b n x th_b, and w =
-// th_b - th_a (n, t: its normal and in-plane parts); K x is its gradient: the
-// force F = kn A dn n + ks A dt on b (-F on a), the moments arm F x n on
-// each (d . (n x th) = th . (F x n)), and the bending and twisting moment
-// M = kn I wt + ks J wn n on b (-M on a).
-void apply(const std::vector<Bond> &bonds, const Atoms &atoms, const std::vector<double> &x,
-           std::vector<double> &y) {
+// M^-1/2 per coordinate: 1 / sqrt(m) for the translations, 1 / sqrt(I)
+// for the rotations (computed once per estimate, not per product).
+std::vector<double> inverse_sqrt_mass(const Atoms &atoms) {
   const size_t n_atoms = atoms.mass.size();
   std::vector<double> scale(6 * n_atoms);
   for (size_t i = 0; i < n_atoms; ++i) {
@@ -45,9 +37,22 @@ void apply(const std::vector<Bond> &bonds, const Atoms &atoms, const std::vector
       scale[6 * i + 3 + c] = si;
     }
   }
-  std::vector<double> q(6 * n_atoms);
+  return scale;
+}
+
+// The energy of a bond is kn A dn^2 / 2 + ks A |dt|^2 / 2 + kn I |wt|^2 / 2 +
+// ks J wn^2 / 2 with d the relative displacement of b's face at the contact
+// point against a's, d = u_b - u_a + arm_a n x th_a + arm_b n x th_b, and w =
+// th_b - th_a (n, t: its normal and in-plane parts); K x is its gradient: the
+// force F = kn A dn n + ks A dt on b (-F on a), the moments arm F x n on
+// each (d . (n x th) = th . (F x n)), and the bending and twisting moment
+// M = kn I wt + ks J wn n on b (-M on a). `scale`: inverse_sqrt_mass; `q`
+// holds M^-1/2 x between the calls.
+void apply_scaled(const std::vector<Bond> &bonds, const std::vector<double> &scale,
+                  const std::vector<double> &x, std::vector<double> &q, std::vector<double> &y) {
+  q.resize(scale.size());
   for (size_t k = 0; k < q.size(); ++k) q[k] = scale[k] * x[k];
-  y.assign(6 * n_atoms, 0.0);
+  y.assign(scale.size(), 0.0);
   for (const Bond &bd : bonds) {
     const size_t ia = 6 * static_cast<size_t>(bd.a), ib = 6 * static_cast<size_t>(bd.b);
     const Vec3 n = bd.n;
@@ -67,6 +72,14 @@ void apply(const std::vector<Bond> &bonds, const Atoms &atoms, const std::vector
   for (size_t k = 0; k < y.size(); ++k) y[k] *= scale[k];
 }
 
+}  // namespace
+
+void apply(const std::vector<Bond> &bonds, const Atoms &atoms, const std::vector<double> &x,
+           std::vector<double> &y) {
+  std::vector<double> q;
+  apply_scaled(bonds, inverse_sqrt_mass(atoms), x, q, y);
+}
+
 Estimate largest_omega2(const std::vector<Bond> &bonds, const Atoms &atoms, const Options &opt) {
   Estimate est;
   const size_t dim = 6 * atoms.mass.size();
@@ -81,11 +94,12 @@ Estimate largest_omega2(const std::vector<Bond> &bonds, const Atoms &atoms, cons
   }
   const double v0 = norm(v);
   for (double &c : v) c /= v0;
-  std::vector<double> alpha, beta;
+  const std::vector<double> scale = inverse_sqrt_mass(atoms);
+  std::vector<double> q, alpha, beta;
   double b_prev = 0.0;
   const int kmax = std::max(1, std::min<int>(opt.max_iterations, static_cast<int>(dim)));
   for (int k = 1; k <= kmax; ++k) {
-    apply(bonds, atoms, v, w);
+    apply_scaled(bonds, scale, v, q, w);
     double a = 0.0;
     for (size_t c = 0; c < dim; ++c) {
       w[c] -= b_prev * v_prev[c];

@@ -62,18 +62,24 @@ struct Bond {
   int i, j;
 };
 
+// The vector d from sphere a's centre to c's, and its length.
+double separation(const Sphere &a, const Sphere &c, double (&d)[3]) {
+  double l2 = 0.0;
+  for (int q = 0; q < 3; ++q) {
+    d[q] = c.x[q] - a.x[q];
+    l2 += d[q] * d[q];
+  }
+  return std::sqrt(l2);
+}
+
 // Adds the parallel bond between spheres i and j (Potyondy & Cundall 2004,
 // eq. 5; axis from i to j, L0 their distance) to the stiffness matrix k of
 // the network, 6 coordinates per sphere (u, theta), row-major n x n.
 void add_bond_stiffness(const BondSprings &s, const std::vector<Sphere> &sp, const Bond &b,
                         std::vector<double> &k, int n) {
   const Sphere &a = sp[b.i], &c = sp[b.j];
-  double d[3], l0 = 0.0;
-  for (int q = 0; q < 3; ++q) {
-    d[q] = c.x[q] - a.x[q];
-    l0 += d[q] * d[q];
-  }
-  l0 = std::sqrt(l0);
+  double d[3];
+  const double l0 = separation(a, c, d);
   double e[3][3];  // bond frame: e[0] the axis, e[1], e[2] perpendicular
   for (int q = 0; q < 3; ++q) e[0][q] = d[q] / l0;
   const double helper[3] = {std::fabs(e[0][0]) < 0.9 ? 1.0 : 0.0,
@@ -340,12 +346,8 @@ namespace {
 mill::network_step::Bond to_network_bond(const BondSprings &s, const std::vector<Sphere> &sp,
                                          const Bond &b) {
   const Sphere &a = sp[b.i], &c = sp[b.j];
-  double d[3], l0 = 0.0;
-  for (int q = 0; q < 3; ++q) {
-    d[q] = c.x[q] - a.x[q];
-    l0 += d[q] * d[q];
-  }
-  l0 = std::sqrt(l0);
+  double d[3];
+  const double l0 = separation(a, c, d);
   mill::network_step::Bond nb;
   nb.a = b.i;
   nb.b = b.j;
