@@ -133,11 +133,7 @@ void FixBondBreakable::parse_args(int narg, char **arg) {
     const char *val = arg[iarg + 1];
     const bool parallel_only =
         key == "moment_factor" || key == "broken_contact" || key == "contact_moment";
-    if (flat_joint_ && key == "lanes") {
-      fail("keyword 'lanes' packs fix bond/breakable's parallel bonds; a flat joint's " +
-           std::string("interfaces are evaluated one at a time: remove it ") +
-           "(docs/styles/fix_bond_flatjoint.md)");
-    } else if (flat_joint_ && parallel_only) {
+    if (flat_joint_ && parallel_only) {
       fail("keyword '" + key + "' is one of fix bond/breakable's parallel bonds; a flat joint " +
            "has none (its elements carry the moments, broken elements stay as frictional " +
            "contacts): remove it (docs/styles/fix_bond_flatjoint.md)");
@@ -924,6 +920,98 @@ void FixBondBreakable::evaluate_flat_joint(const AtomArrays &at, ListedBond &bon
   out.fj_bonded = r.bonded;
 }
 
+// True for an interface with every element bonded (intact, or softened to
+// a damage below 1): what the packed kernel takes (flat_joint::update_intact).
+bool FixBondBreakable::flat_joint_packable(const ListedBond &bond) const {
+  const double *el = bond.fj + mill::flat_joint::kHistory + mill::flat_joint::kState;
+  for (int e = 0; e < fj_layout_.elements(); ++e)
+    if (!(el[3 * e] < 1.0)) return false;
+  return bond.state == 0.0;
+}
+
+// evaluate_flat_joint for kLanes<L> bonded interfaces at once, one per lane
+// of a pack (flat_joint::update_intact): the same expressions, so a lane's
+// result is bitwise the one-interface result (tested: FlatJointKernel.*).
+// Returns a bit per lane that held (history advanced, outs[k] written);
+// the caller evaluates the others one at a time (their history untouched).
+// Advancing steps only.
+template <class L>
+inline int FixBondBreakable::evaluate_flat_joint_lanes(const AtomArrays &at,
+                                                       ListedBond *const *bonds,
+                                                       BondResult *outs) const {
+  constexpr int N = kLanes<L>;
+  const double *xa[N], *xb[N], *va_p[N], *vb_p[N], *wa_p[N], *wb_p[N];
+  double *hist[N];
+  L ra, rb, l0, kna, ksa, inv_area, rbond, cn, cs;
+  for (int k = 0; k < N; ++k) {
+    const ListedBond &lb = *bonds[k];
+    xa[k] = at.x[lb.a], xb[k] = at.x[lb.b];
+    va_p[k] = at.v[lb.a], vb_p[k] = at.v[lb.b];
+    wa_p[k] = at.omega[lb.a], wb_p[k] = at.omega[lb.b];
+    hist[k] = lb.fj;
+    ra[k] = at.radius[lb.a], rb[k] = at.radius[lb.b];
+    l0[k] = lb.l0, kna[k] = lb.kna, ksa[k] = lb.ksa, inv_area[k] = lb.inv_area;
+    rbond[k] = lb.rbond, cn[k] = lb.cn, cs[k] = lb.cs;
+  }
+  const V3<L> va = gather3<L>(va_p), vb = gather3<L>(vb_p);
+  const V3<L> wa = gather3<L>(wa_p), wb = gather3<L>(wb_p);
+  const V3<L> d = gather3<L>(xb) - gather3<L>(xa);
+  const L len = vsqrt(dot(d, d));
+  const bool dashpots = damping_ > 0.0;  // every lane's interface holds (state 0)
+  const PairMotionT<L> m = dashpots ? pair_motion(d, len, va, vb, wa, wb, ra, rb)
+                                    : pair_geometry(d, len, va, vb, wa, wb, ra, rb);
+  const L dt = L{} + at.dt;
+  const V3<L> dmid = d - (0.5 * dt) * m.vrel_ab;
+  const PairMotionT<L> h = pair_motion(dmid, vsqrt(dot(dmid, dmid)), va, vb, wa, wb, ra, rb);
+  mill::flat_joint::IntactStep<L> st;
+  st.n_mid = h.n;
+  st.n_end = m.n;
+  st.du_shear = dt * h.vt;
+  st.dtheta = dt * (wb - wa);
+  st.spin = 0.5 * (dot(wa, m.n) + dot(wb, m.n)) * at.dt;
+  st.stretch = len - l0;
+  mill::flat_joint::IntactParams<L> mat;
+  mat.kn = kna * inv_area;
+  mat.ks = ksa * inv_area;
+  mat.radius = rbond;
+  mill::flat_joint::Params p;
+  p.tensile = tensile_strength_;
+  p.cohesion = cohesion_;
+  p.tan_phi = tan_friction_;
+  p.softening = fj_softening_;
+  mill::flat_joint::IntactResult<L> r;
+  const auto holds = mill::flat_joint::update_intact(hist, fj_layout_, mat, p, st, r);
+  V3<L> fdash{L{}, L{}, L{}};
+  if (dashpots) fdash = -(cn * m.vn * m.n + cs * m.vt);
+  const V3<L> fb = r.force_b + fdash;
+  const V3<L> fa = -fb;
+  const V3<L> ta = cross(m.ra, fa) - r.moment_b;
+  const V3<L> tb = cross(m.rb, fb) + r.moment_b;
+  const int ne = fj_layout_.elements();
+  int held = 0;
+  for (int k = 0; k < N; ++k) {
+    if (!holds[k]) continue;
+    held |= 1 << k;
+    BondResult &out = outs[k];
+    out.fdash = lane(fdash, k);
+    out.fa = lane(fa, k);
+    out.ta = lane(ta, k);
+    out.tb = lane(tb, k);
+    out.energy = r.energy[k];
+    out.slipped = 0.0;
+    out.released = 0.0;
+    out.stretch = st.stretch[k];
+    out.sigma = 0.0;
+    out.tau = 0.0;
+    out.strength = 1.0;
+    out.mode = 0;
+    out.fj_tension = 0;
+    out.fj_shear = 0;
+    out.fj_bonded = ne;
+  }
+  return held;
+}
+
 // A pair whose interface is fully broken has separated past its bonding
 // range, L0 + g min(Ri, Rj): the interface is dropped.
 bool FixBondBreakable::separated(const AtomArrays &at, const ListedBond &bond) const {
@@ -1111,6 +1199,34 @@ void FixBondBreakable::compute_bonds(bool advance) {
   };
 
   const int nlisted = static_cast<int>(list_.size());
+  // bond/flatjoint: an interface once evaluated: its force on the atoms, the
+  // counters and its break events.
+  auto finish_interface = [&](int e, ListedBond &lb, const BondResult &res) {
+    apply(lb, res);
+    if (lb.state == 0.0 && res.fj_bonded == 0) contact_.push_back(e);  // all elements broken
+    if (!lb.i_lower) return;  // counted once: by the owner of the lower tag
+    local[3] += res.energy;   // output 5: the energy in the elements, bonded or pressed
+    ledger_.friction += res.slipped;
+    ledger_.released += res.released;
+    if (damping_ > 0.0) store3(&dash_[3 * e], res.fdash);
+    local[1] += res.fj_tension;
+    local[2] += res.fj_shear;
+    if (lb.state == 0.0 && res.fj_bonded > 0) local[0] += 1.0;
+    if (advance && res.fj_tension + res.fj_shear > 0) {
+      const double ev[kEventCols] = {static_cast<double>(update->ntimestep),
+                                     update->get_cur_time(),
+                                     res.centre.x,
+                                     res.centre.y,
+                                     res.centre.z,
+                                     res.fj_tension > 0 ? 1.0 : 2.0,
+                                     static_cast<double>(tag[lb.i]),
+                                     bonds_[lb.i][lb.slot_i * ncol_ + PARTNER],
+                                     res.sigma,
+                                     res.tau};
+      events_.insert(events_.end(), ev, ev + kEventCols);
+    }
+  };
+  BondResult fj_out[4];
   for (int e = 0; e < nlisted && flat_joint_; ++e) {
     // bond/flatjoint: every interface, bonded or not, through its elements;
     // one whose elements are all broken stays until the pair separates.
@@ -1119,30 +1235,37 @@ void FixBondBreakable::compute_bonds(bool advance) {
       if (advance) remove_later(lb);
       continue;
     }
-    evaluate_flat_joint(at, lb, advance, r);
-    apply(lb, r);
-    if (lb.state == 0.0 && r.fj_bonded == 0) contact_.push_back(e);  // all elements broken
-    if (!lb.i_lower) continue;  // counted once: by the owner of the lower tag
-    local[3] += r.energy;  // output 5: the energy in the elements, bonded or pressed
-    ledger_.friction += r.slipped;
-    ledger_.released += r.released;
-    if (damping_ > 0.0) store3(&dash_[3 * e], r.fdash);
-    local[1] += r.fj_tension;
-    local[2] += r.fj_shear;
-    if (lb.state == 0.0 && r.fj_bonded > 0) local[0] += 1.0;
-    if (advance && r.fj_tension + r.fj_shear > 0) {
-      const double ev[kEventCols] = {static_cast<double>(update->ntimestep),
-                                     update->get_cur_time(),
-                                     r.centre.x,
-                                     r.centre.y,
-                                     r.centre.z,
-                                     r.fj_tension > 0 ? 1.0 : 2.0,
-                                     static_cast<double>(tag[lb.i]),
-                                     bonds_[lb.i][lb.slot_i * ncol_ + PARTNER],
-                                     r.sigma,
-                                     r.tau};
-      events_.insert(events_.end(), ev, ev + kEventCols);
+    // Interfaces in a row whose elements are all bonded (intact or
+    // softened): two or four at a time, one per lane (none reads what
+    // another's finish writes); a lane where an element breaks or softens
+    // further this step goes
+    // through the one-interface code, from its untouched history; then
+    // finished in list order.
+    int run = 0;
+    while (advance && run < lanes_ && e + run < nlisted && flat_joint_packable(list_[e + run]))
+      ++run;
+    if (run >= 2) {
+      ListedBond *pack[4];
+      const int n = run >= 4 ? 4 : 2;
+      for (int k = 0; k < n; ++k) pack[k] = &list_[e + k];
+      const int held = n == 4 ? evaluate_flat_joint_lanes<Lane4>(at, pack, fj_out)
+                              : evaluate_flat_joint_lanes<Lane2>(at, pack, fj_out);
+      for (int k = 0; k < n; ++k) {
+        if (held >> k & 1) {
+          evals_packed_ += 1.0;
+          finish_interface(e + k, list_[e + k], fj_out[k]);
+        } else {
+          evaluate_flat_joint(at, list_[e + k], advance, r);
+          evals_single_ += 1.0;
+          finish_interface(e + k, list_[e + k], r);
+        }
+      }
+      e += n - 1;
+      continue;
     }
+    evaluate_flat_joint(at, lb, advance, r);
+    if (lb.state == 0.0) evals_single_ += 1.0;
+    finish_interface(e, lb, r);
   }
   // An intact bond once evaluated: its break (counted, logged, turned into a
   // contact or removed) or its force on the atoms.

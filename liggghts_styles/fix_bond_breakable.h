@@ -127,7 +127,7 @@ class FixBondBreakable : public Fix {
   std::string break_log_path_;
   std::string dump_bonds_path_;
   int dump_every_ = 0;
-  int lanes_ = 2;  // intact bonds evaluated at once (1, 2, 4; bond_lanes.h)
+  int lanes_ = 2;  // intact bonds (interfaces) evaluated at once (1, 2, 4; bond_lanes.h)
   // step_estimate network: the critical step from the whole network's largest
   // eigenfrequency (network_step.h) instead of the per-atom sum alone.
   bool network_step_ = false;
@@ -242,6 +242,10 @@ class FixBondBreakable : public Fix {
                         BondResult &out) const;
   void evaluate_flat_joint(const AtomArrays &at, ListedBond &bond, bool advance,
                            BondResult &out) const;
+  template <class L>
+  int evaluate_flat_joint_lanes(const AtomArrays &at, ListedBond *const *bonds,
+                                BondResult *outs) const;
+  bool flat_joint_packable(const ListedBond &bond) const;
   bool separated(const AtomArrays &at, const ListedBond &bond) const;
   void store_history();
   void remove_slot(int i, int slot);

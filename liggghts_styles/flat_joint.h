@@ -25,9 +25,11 @@
 #include <vector>
 
 #include "bond_geometry.h"
+#include "bond_lanes.h"
 
 namespace mill::flat_joint {
 
+using bond_geometry::V3;
 using bond_geometry::Vec3;
 
 // Most elements one interface may have (Nr x Na).
@@ -157,6 +159,179 @@ struct Stiffness {
   double normal, shear, bending, twisting;
 };
 Stiffness intact_stiffness(const Layout &lay, const Params &p);
+
+// ---------------------------------------------------------------------------
+// Several intact interfaces side by side (fix bond/flatjoint's packed kernel,
+// docs/styles/fix_bond_flatjoint.md, "Packed kernel"): update() for 2 or 4
+// interfaces at once, one per lane of a pack (bond_lanes.h), for the common
+// case of an impact: every element bonded (intact, or softened to a damage
+// D < 1), Step::advance true and Step::stresses false. Each lane does
+// update()'s arithmetic in update()'s order, so its result is bitwise
+// update()'s (tested: FlatJointKernel.*); a lane in which some element
+// would break or soften further this step, or which holds a broken
+// element, does not hold: its history is left untouched and its result is
+// void, and the caller runs update() for it.
+
+// The step of each lane (the Step fields an intact interface reads).
+template <class T>
+struct IntactStep {
+  V3<T> n_mid, n_end, du_shear, dtheta;
+  T spin, stretch;
+};
+// Each lane's material (Params::kn, ks, radius); the strengths and the
+// softening are the fix's, the same in every lane.
+template <class T>
+struct IntactParams {
+  T kn, ks, radius;
+};
+// What update() returns for an intact interface that stays intact: its
+// force and moment, its stored energy and whether it carries force; the
+// other Result fields are update()'s constants there (bonded = elements,
+// no break, nothing slipped or released, sigma_max = tau_ratio = 0).
+template <class T>
+struct IntactResult {
+  V3<T> force_b, moment_b;
+  T energy;
+  decltype(T{} < T{}) loaded;
+};
+
+namespace detail {
+// sin_cos of flat_joint.cpp per lane: the series below kSeriesTurn, the
+// library's sin and cos in the (rare) lanes above it.
+template <class T>
+[[gnu::always_inline]] inline void sin_cos_lanes(T a, T &sn, T &cs) {
+  const T a2 = a * a;
+  sn = a * (1.0 - a2 * (1.0 / 6.0) * (1.0 - a2 * (1.0 / 20.0)));
+  cs = 1.0 - 0.5 * a2 * (1.0 - a2 * (1.0 / 12.0));
+  for (int l = 0; l < bond_geometry::kLanes<T>; ++l)
+    if (std::fabs(a[l]) >= kSeriesTurn) {
+      sn[l] = std::sin(a[l]);
+      cs[l] = std::cos(a[l]);
+    }
+}
+// turn() of flat_joint.cpp per lane (its spin != 0 branch a select).
+template <class T>
+[[gnu::always_inline]] inline V3<T> turn_lanes(V3<T> t1, V3<T> n0, V3<T> n1, T spin) {
+  const V3<T> s = n0 + n1;
+  t1 = t1 - (dot(s, t1) / (1.0 + dot(n0, n1))) * s;
+  T sn, cs;
+  sin_cos_lanes(spin, sn, cs);
+  const V3<T> spun = cs * t1 + sn * cross(n1, t1);
+  return bond_geometry::select(spin != 0.0, spun, t1);
+}
+// carry_inline() of flat_joint.cpp per lane.
+template <class T>
+[[gnu::always_inline]] inline V3<T> carry_lanes(V3<T> t1, V3<T> n0, V3<T> n1, T spin) {
+  t1 = turn_lanes(t1, n0, n1, spin);
+  t1 = t1 - dot(t1, n1) * n1;
+  return (1.0 / bond_geometry::vsqrt(dot(t1, t1))) * t1;
+}
+template <class T>
+[[gnu::always_inline]] inline V3<T> gather_v3(double *const *h, int k) {
+  return {bond_geometry::gather<T>(h, k), bond_geometry::gather<T>(h, k + 1),
+          bond_geometry::gather<T>(h, k + 2)};
+}
+}  // namespace detail
+
+// update() of the interfaces whose histories are h[0..lanes-1], each with
+// every element bonded at the start of the step; returns the lanes that hold (all ones: held, its
+// history advanced and `out` its result; zero: untouched, run update()).
+template <class T>
+[[gnu::always_inline]] inline auto update_intact(double *const *h, const Layout &lay,
+                                                 const IntactParams<T> &mat, const Params &p,
+                                                 const IntactStep<T> &s, IntactResult<T> &out)
+    -> decltype(T{} < T{}) {
+  using M = decltype(T{} < T{});
+  using bond_geometry::gather;
+  constexpr double kPiLane = 3.14159265358979323846;
+  const T radius = mat.radius, area = kPiLane * radius * radius;
+  const T kn = mat.kn, kna_all = kn * area, ksa_all = mat.ks * area;
+  const double cohesion = p.cohesion, tan_phi = p.tan_phi, tensile = p.tensile;
+  const bool softens = p.softening > 1.0;
+  const double *px = lay.px.data(), *py = lay.py.data(), *pa = lay.area.data();
+  const double *inv_a = lay.inv_area.data();
+
+  // The frame and the bend rotation, advanced as update() does.
+  V3<T> t1 = detail::gather_v3<T>(h, kT1);
+  t1 = detail::turn_lanes(t1, detail::gather_v3<T>(h, kNormal), s.n_mid, T(0.5 * s.spin));
+  const V3<T> t2_mid = cross(s.n_mid, t1);
+  const T du1 = dot(s.du_shear, t1);
+  const T du2 = dot(s.du_shear, t2_mid);
+  const T twist = dot(s.dtheta, s.n_mid);
+  const T th1 = gather<T>(h, kBend) + dot(s.dtheta, t1);
+  const T th2 = gather<T>(h, kBend + 1) + dot(s.dtheta, t2_mid);
+  t1 = detail::carry_lanes(t1, s.n_mid, s.n_end, T(0.5 * s.spin));
+
+  const V3<T> n = s.n_end;
+  const V3<T> t2 = cross(n, t1);
+  const T zero{}, one = zero + 1.0;
+  T f1 = zero, f2 = zero, fn = zero, m1 = zero, m2 = zero, mn = zero;
+  T sum_n = zero, sum_s = zero;
+  M holds = zero == zero;  // all ones
+  T shear_out[2 * kMaxElements];
+  const int ne = lay.elements();
+  for (int e = 0; e < ne; ++e) {
+    const T x = radius * px[e], y = radius * py[e];
+    const T kna = kna_all * pa[e], ksa = ksa_all * pa[e];
+    const int base = kHistory + 3 * e;
+    const T damage = gather<T>(h, base + kState);
+    holds &= damage < 1.0;  // bonded: intact, or softened to damage D < 1
+    T s1 = gather<T>(h, base + kShear), s2 = gather<T>(h, base + kShear + 1);
+    s1 -= ksa * (du1 - twist * y);
+    s2 -= ksa * (du2 + twist * x);
+    const T u = s.stretch + th1 * y - th2 * x;
+    T normal = kna * u;
+    // A softened element opened in tension carries (1 - D) of it (keep);
+    // otherwise keep = 1, and x 1 and / 1 are exact: update()'s values.
+    T keep = one, inv_keep = one;
+    M grows = zero != zero;  // softening: the damage grows or the element breaks
+    if (softens) {
+      keep = u > 0.0 ? 1.0 - damage : one;
+      inv_keep = 1.0 / keep;
+      normal *= keep;
+      const T u_t = tensile / kn, u_s = p.softening * u_t;
+      const T d_env = 1.0 - tensile * (u_s - u) / ((u_s - u_t) * kn * u);
+      grows = (u >= u_s) | ((u > u_t) & (u < u_s) & (d_env > damage));
+    }
+    const T sigma = keep * kn * u;
+    const T strength = cohesion - sigma * tan_phi;
+    const T s_sq = s1 * s1 + s2 * s2;
+    const T lim = strength * area * pa[e], lim_sq = lim * lim;
+    const M positive = strength > 0.0;
+    const M shear_fails =
+        (positive & (s_sq > lim_sq)) | (~positive & ((strength < 0.0) | (s_sq > 0.0)));
+    // Brittle: it breaks past sigma_c (update() then changes its state).
+    const M tension = softens ? grows : M(sigma > tensile);
+    holds &= ~(shear_fails | tension);
+    shear_out[2 * e] = s1;
+    shear_out[2 * e + 1] = s2;
+    sum_n += normal * normal * inv_a[e] * inv_keep;
+    sum_s += (s1 * s1 + s2 * s2) * inv_a[e];
+    f1 += s1;
+    f2 += s2;
+    fn -= normal;
+    m1 -= y * normal;
+    m2 += x * normal;
+    mn += x * s2 - y * s1;
+  }
+  out.energy = 0.5 * (sum_n / kna_all + sum_s / ksa_all);
+  out.loaded = (sum_n > 0.0) | (sum_s > 0.0);
+  out.force_b = f1 * t1 + f2 * t2 + fn * n;
+  out.moment_b = m1 * t1 + m2 * t2 + mn * n;
+  // The history of the lanes that hold.
+  for (int l = 0; l < bond_geometry::kLanes<T>; ++l) {
+    if (!holds[l]) continue;
+    double *hl = h[l];
+    hl[kT1] = t1.x[l], hl[kT1 + 1] = t1.y[l], hl[kT1 + 2] = t1.z[l];
+    hl[kNormal] = n.x[l], hl[kNormal + 1] = n.y[l], hl[kNormal + 2] = n.z[l];
+    hl[kBend] = th1[l], hl[kBend + 1] = th2[l];
+    for (int e = 0; e < ne; ++e) {
+      hl[kHistory + 3 * e + kShear] = shear_out[2 * e][l];
+      hl[kHistory + 3 * e + kShear + 1] = shear_out[2 * e + 1][l];
+    }
+  }
+  return holds;
+}
 
 }  // namespace mill::flat_joint
 
