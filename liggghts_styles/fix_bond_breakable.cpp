@@ -942,17 +942,23 @@ inline int FixBondBreakable::evaluate_flat_joint_lanes(const AtomArrays &at,
   constexpr int N = kLanes<L>;
   const double *xa[N], *xb[N], *va_p[N], *vb_p[N], *wa_p[N], *wb_p[N];
   double *hist[N];
-  L ra, rb, l0, kna, ksa, inv_area, rbond, cn, cs;
   for (int k = 0; k < N; ++k) {
     const ListedBond &lb = *bonds[k];
     xa[k] = at.x[lb.a], xb[k] = at.x[lb.b];
     va_p[k] = at.v[lb.a], vb_p[k] = at.v[lb.b];
     wa_p[k] = at.omega[lb.a], wb_p[k] = at.omega[lb.b];
     hist[k] = lb.fj;
-    ra[k] = at.radius[lb.a], rb[k] = at.radius[lb.b];
-    l0[k] = lb.l0, kna[k] = lb.kna, ksa[k] = lb.ksa, inv_area[k] = lb.inv_area;
-    rbond[k] = lb.rbond, cn[k] = lb.cn, cs[k] = lb.cs;
   }
+  // Each constant as one pack (lanes_of: no lane-by-lane stores).
+  const L ra = lanes_of<L>([&](int k) { return at.radius[bonds[k]->a]; });
+  const L rb = lanes_of<L>([&](int k) { return at.radius[bonds[k]->b]; });
+  const L l0 = lanes_of<L>([&](int k) { return bonds[k]->l0; });
+  const L kna = lanes_of<L>([&](int k) { return bonds[k]->kna; });
+  const L ksa = lanes_of<L>([&](int k) { return bonds[k]->ksa; });
+  const L inv_area = lanes_of<L>([&](int k) { return bonds[k]->inv_area; });
+  const L rbond = lanes_of<L>([&](int k) { return bonds[k]->rbond; });
+  const L cn = lanes_of<L>([&](int k) { return bonds[k]->cn; });
+  const L cs = lanes_of<L>([&](int k) { return bonds[k]->cs; });
   const V3<L> va = gather3<L>(va_p), vb = gather3<L>(vb_p);
   const V3<L> wa = gather3<L>(wa_p), wb = gather3<L>(wb_p);
   const V3<L> d = gather3<L>(xb) - gather3<L>(xa);
@@ -988,19 +994,22 @@ inline int FixBondBreakable::evaluate_flat_joint_lanes(const AtomArrays &at,
   const V3<L> ta = cross(m.ra, fa) - r.moment_b;
   const V3<L> tb = cross(m.rb, fb) + r.moment_b;
   const int ne = fj_layout_.elements();
-  int held = 0;
+  const Spilled3<L> fdash_k(fdash), fa_k(fa), ta_k(ta), tb_k(tb);
+  alignas(32) double energy_k[N], stretch_k[N];
+  std::memcpy(energy_k, &r.energy, sizeof(L));
+  std::memcpy(stretch_k, &st.stretch, sizeof(L));
+  const int held = lane_bits(holds);
   for (int k = 0; k < N; ++k) {
-    if (!holds[k]) continue;
-    held |= 1 << k;
+    if (!(held >> k & 1)) continue;
     BondResult &out = outs[k];
-    out.fdash = lane(fdash, k);
-    out.fa = lane(fa, k);
-    out.ta = lane(ta, k);
-    out.tb = lane(tb, k);
-    out.energy = r.energy[k];
+    out.fdash = fdash_k[k];
+    out.fa = fa_k[k];
+    out.ta = ta_k[k];
+    out.tb = tb_k[k];
+    out.energy = energy_k[k];
     out.slipped = 0.0;
     out.released = 0.0;
-    out.stretch = st.stretch[k];
+    out.stretch = stretch_k[k];
     out.sigma = 0.0;
     out.tau = 0.0;
     out.strength = 1.0;

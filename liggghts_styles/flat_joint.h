@@ -203,8 +203,10 @@ template <class T>
   const T a2 = a * a;
   sn = a * (1.0 - a2 * (1.0 / 6.0) * (1.0 - a2 * (1.0 / 20.0)));
   cs = 1.0 - 0.5 * a2 * (1.0 - a2 * (1.0 / 12.0));
+  const int big = bond_geometry::lane_bits(bond_geometry::vfabs(a) >= kSeriesTurn);
+  if (big == 0) return;  // the usual case: every lane's turn below the switch
   for (int l = 0; l < bond_geometry::kLanes<T>; ++l)
-    if (std::fabs(a[l]) >= kSeriesTurn) {
+    if (big >> l & 1) {
       sn[l] = std::sin(a[l]);
       cs[l] = std::cos(a[l]);
     }
@@ -319,12 +321,14 @@ template <class T>
   out.force_b = f1 * t1 + f2 * t2 + fn * n;
   out.moment_b = m1 * t1 + m2 * t2 + mn * n;
   // The history of the lanes that hold.
+  const bond_geometry::Spilled3<T> t1_l(t1), n_l(n), bend_l(V3<T>{th1, th2, zero});
+  const int held = bond_geometry::lane_bits(holds);
   for (int l = 0; l < bond_geometry::kLanes<T>; ++l) {
-    if (!holds[l]) continue;
+    if (!(held >> l & 1)) continue;
     double *hl = h[l];
-    hl[kT1] = t1.x[l], hl[kT1 + 1] = t1.y[l], hl[kT1 + 2] = t1.z[l];
-    hl[kNormal] = n.x[l], hl[kNormal + 1] = n.y[l], hl[kNormal + 2] = n.z[l];
-    hl[kBend] = th1[l], hl[kBend + 1] = th2[l];
+    hl[kT1] = t1_l.x[l], hl[kT1 + 1] = t1_l.y[l], hl[kT1 + 2] = t1_l.z[l];
+    hl[kNormal] = n_l.x[l], hl[kNormal + 1] = n_l.y[l], hl[kNormal + 2] = n_l.z[l];
+    hl[kBend] = bend_l.x[l], hl[kBend + 1] = bend_l.y[l];
     for (int e = 0; e < ne; ++e) {
       hl[kHistory + 3 * e + kShear] = shear_out[2 * e][l];
       hl[kHistory + 3 * e + kShear + 1] = shear_out[2 * e + 1][l];
