@@ -1247,9 +1247,8 @@ void FixBondBreakable::compute_bonds(bool advance) {
     // Interfaces in a row whose elements are all bonded (intact or
     // softened): two or four at a time, one per lane (none reads what
     // another's finish writes); a lane where an element breaks or softens
-    // further this step goes
-    // through the one-interface code, from its untouched history; then
-    // finished in list order.
+    // further this step goes through the one-interface code, from its
+    // untouched history; then all are finished in list order.
     int run = 0;
     while (advance && run < lanes_ && e + run < nlisted && flat_joint_packable(list_[e + run]))
       ++run;

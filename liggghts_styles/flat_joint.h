@@ -161,7 +161,7 @@ struct Stiffness {
 Stiffness intact_stiffness(const Layout &lay, const Params &p);
 
 // ---------------------------------------------------------------------------
-// Several intact interfaces side by side (fix bond/flatjoint's packed kernel,
+// Several bonded interfaces side by side (fix bond/flatjoint's packed kernel,
 // docs/styles/fix_bond_flatjoint.md, "Packed kernel"): update() for 2 or 4
 // interfaces at once, one per lane of a pack (bond_lanes.h), for the common
 // case of an impact: every element bonded (intact, or softened to a damage
@@ -184,7 +184,7 @@ template <class T>
 struct IntactParams {
   T kn, ks, radius;
 };
-// What update() returns for an intact interface that stays intact: its
+// What update() returns for a bonded interface that stays so: its
 // force and moment, its stored energy and whether it carries force; the
 // other Result fields are update()'s constants there (bonded = elements,
 // no break, nothing slipped or released, sigma_max = tau_ratio = 0).
