@@ -171,11 +171,9 @@ Result update(double *h, const Layout &lay, const Params &p, const Step &s) {
   const Vec3 t2 = cross(n, t1);
   const double th1 = h[kBend], th2 = h[kBend + 1];
   Result out;
-  // Force on b and its moment about the contact point, in (t1, t2, n): an
-  // element at r = x t1 + y t2 pushing f = -N n + S1 t1 + S2 t2 adds
-  // r x f = -y N t1 + x N t2 + (x S2 - y S1) n.
-  double f1 = 0.0, f2 = 0.0, fn = 0.0, m1 = 0.0, m2 = 0.0, mn = 0.0;
-  double sum_n = 0.0, sum_s = 0.0;  // sum_e N_e^2 / a_e, |S_e|^2 / a_e (energy)
+  // Force on b, its moment about the contact point and the stored energy,
+  // summed over the elements in (t1, t2, n) (flat_joint.h, ElementSums).
+  ElementSums<double> sums;
   // The bonded elements' stresses at the start of the step, for sigma_max
   // and tau_ratio after the loop (when they are wanted).
   int checked = 0;  // bonded elements at the start of the step
@@ -285,21 +283,12 @@ Result update(double *h, const Layout &lay, const Params &p, const Step &s) {
       el[kShear] = s1;
       el[kShear + 1] = s2;
     }
-    // A softened element opened in tension stores N^2 / (2 (1 - D) kn A_e).
-    sum_n += normal * normal * inv_a[e] * inv_keep;
-    sum_s += (s1 * s1 + s2 * s2) * inv_a[e];
-    f1 += s1;
-    f2 += s2;
-    fn -= normal;
-    m1 -= y * normal;
-    m2 += x * normal;
-    mn += x * s2 - y * s1;
+    sums.add(normal, s1, s2, x, y, inv_a[e], inv_keep);
   }
-  // sum_e N_e^2 / (2 kn A_e) + |S_e|^2 / (2 ks A_e), A_e = a_e A.
-  out.energy = 0.5 * (sum_n / kna_all + sum_s / ksa_all);
+  out.energy = sums.energy(kna_all, ksa_all);
   // Some element carries force when some N_e or S_e is not zero (a force
   // below 1e-154 N, whose square underflows, counts as none).
-  out.loaded = sum_n > 0.0 || sum_s > 0.0;
+  out.loaded = sums.sum_n > 0.0 || sums.sum_s > 0.0;
   if (s.stresses || out.broke_tension + out.broke_shear > 0) {
     for (int c = 0; c < checked; ++c) {
       const double tau = std::sqrt(shear_sq_e[c]) / (area * pa[checked_e[c]]);
@@ -307,8 +296,8 @@ Result update(double *h, const Layout &lay, const Params &p, const Step &s) {
       out.tau_ratio = std::max(out.tau_ratio, strength_e[c] > 0.0 ? tau / strength_e[c] : HUGE_VAL);
     }
   }
-  out.force_b = f1 * t1 + f2 * t2 + fn * n;
-  out.moment_b = m1 * t1 + m2 * t2 + mn * n;
+  out.force_b = sums.force(t1, t2, n);
+  out.moment_b = sums.moment(t1, t2, n);
   return out;
 }
 

@@ -160,6 +160,32 @@ struct Stiffness {
 };
 Stiffness intact_stiffness(const Layout &lay, const Params &p);
 
+// The sums over an interface's elements that update() and update_intact()
+// both make, in one place so that the packed lanes stay bitwise update():
+// the force and moment on b in the frame (t1, t2, n) (an element at
+// r = x t1 + y t2 pushing f = -N n + S1 t1 + S2 t2 adds r x f =
+// -y N t1 + x N t2 + (x S2 - y S1) n) and sum_e N_e^2 / a_e,
+// |S_e|^2 / a_e for the stored energy (a_e = A_e / A; a softened element
+// opened in tension stores N^2 / (2 (1 - D) kn A_e): inv_keep = 1 / (1 - D)).
+template <class T>
+struct ElementSums {
+  T f1{}, f2{}, fn{}, m1{}, m2{}, mn{}, sum_n{}, sum_s{};
+  [[gnu::always_inline]] void add(T normal, T s1, T s2, T x, T y, double inv_a, T inv_keep) {
+    sum_n += normal * normal * inv_a * inv_keep;
+    sum_s += (s1 * s1 + s2 * s2) * inv_a;
+    f1 += s1;
+    f2 += s2;
+    fn -= normal;
+    m1 -= y * normal;
+    m2 += x * normal;
+    mn += x * s2 - y * s1;
+  }
+  // sum_e N_e^2 / (2 kn A_e) + |S_e|^2 / (2 ks A_e), A_e = a_e A.
+  T energy(T kna_all, T ksa_all) const { return 0.5 * (sum_n / kna_all + sum_s / ksa_all); }
+  V3<T> force(V3<T> t1, V3<T> t2, V3<T> n) const { return f1 * t1 + f2 * t2 + fn * n; }
+  V3<T> moment(V3<T> t1, V3<T> t2, V3<T> n) const { return m1 * t1 + m2 * t2 + mn * n; }
+};
+
 // ---------------------------------------------------------------------------
 // Several bonded interfaces side by side (fix bond/flatjoint's packed kernel,
 // docs/styles/fix_bond_flatjoint.md, "Packed kernel"): update() for 2 or 4
@@ -267,8 +293,7 @@ template <class T>
   const V3<T> n = s.n_end;
   const V3<T> t2 = cross(n, t1);
   const T zero{}, one = zero + 1.0;
-  T f1 = zero, f2 = zero, fn = zero, m1 = zero, m2 = zero, mn = zero;
-  T sum_n = zero, sum_s = zero;
+  ElementSums<T> sums;
   M holds = zero == zero;  // all ones
   T shear_out[2 * kMaxElements];
   const int ne = lay.elements();
@@ -307,19 +332,12 @@ template <class T>
     holds &= ~(shear_fails | tension);
     shear_out[2 * e] = s1;
     shear_out[2 * e + 1] = s2;
-    sum_n += normal * normal * inv_a[e] * inv_keep;
-    sum_s += (s1 * s1 + s2 * s2) * inv_a[e];
-    f1 += s1;
-    f2 += s2;
-    fn -= normal;
-    m1 -= y * normal;
-    m2 += x * normal;
-    mn += x * s2 - y * s1;
+    sums.add(normal, s1, s2, x, y, inv_a[e], inv_keep);
   }
-  out.energy = 0.5 * (sum_n / kna_all + sum_s / ksa_all);
-  out.loaded = (sum_n > 0.0) | (sum_s > 0.0);
-  out.force_b = f1 * t1 + f2 * t2 + fn * n;
-  out.moment_b = m1 * t1 + m2 * t2 + mn * n;
+  out.energy = sums.energy(kna_all, ksa_all);
+  out.loaded = (sums.sum_n > 0.0) | (sums.sum_s > 0.0);
+  out.force_b = sums.force(t1, t2, n);
+  out.moment_b = sums.moment(t1, t2, n);
   // The history of the lanes that hold.
   const bond_geometry::Spilled3<T> t1_l(t1), n_l(n), bend_l(V3<T>{th1, th2, zero});
   const int held = bond_geometry::lane_bits(holds);
