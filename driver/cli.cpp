@@ -405,6 +405,7 @@ int stage_command(const config::CaseConfig& cfg, const CliArgs& a, const std::st
       !warning.empty())
     err << "warning: " << warning << "\n";
   inv.opts.np = a.np > 0 ? a.np : static_cast<int>(cfg.doc.integer("resources.np"));
+  inv.np_given = a.np > 0;
   inv.opts.jobs = a.jobs > 0 ? a.jobs : static_cast<int>(cfg.doc.integer("resources.jobs"));
   inv.opts.force = a.force;
   if (const char* job = std::getenv("MILL_SCHEDULER_JOB")) inv.opts.scheduler_job = job;

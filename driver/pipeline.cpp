@@ -15,6 +15,7 @@
 #include <sstream>
 #include <thread>
 
+#include "config/schema.h"
 #include "engine/runner.h"
 #include "jobs/job_store.h"
 #include "progress.h"
@@ -219,14 +220,17 @@ void print_tasks(std::ostream& out, const Invocation& inv, const std::string& na
 
 // --dry-run: the stage, its jobs, which are done and their ids (only job
 // --task with --task, which runs no merge).
-void print_plan(std::ostream& out, const Invocation& inv, const Stage& stage, const Plan& plan,
-                const std::vector<JobRow>& rows) {
+void print_plan(std::ostream& out, const Invocation& inv, const StageContext& ctx,
+                const Stage& stage, const Plan& plan, const std::vector<JobRow>& rows) {
   const int n_done = static_cast<int>(std::count_if(rows.begin(), rows.end(), [](const JobRow& r) {
     return r.verdict.decision == jobs::Decision::Skip;
   }));
   out << fmt::format("stage {} - {}{}\n  {} job{}, {} done, {} to run\n", stage.name(),
                      stage.description(), stage.implemented() ? "" : " [not implemented yet]",
                      rows.size(), rows.size() == 1 ? "" : "s", n_done, rows.size() - n_done);
+  if (ctx.opts.np != inv.opts.np)
+    out << fmt::format("  {} MPI rank(s) per engine run (resources.{}.np)\n", ctx.opts.np,
+                       stage.name());
   if (!plan.note.empty()) out << "  note: " << plan.note << "\n";
   if (inv.task)
     out << fmt::format("  --task {}: only this job would run, and the stage would not be merged\n",
@@ -351,8 +355,21 @@ int run_stage(const StagePass& p, const Invocation& inv, std::ostream& out) {
       static_cast<int>(std::count_if(todo.begin(), todo.end(), [](const JobRow& r) {
         return r.verdict.decision == jobs::Decision::Skip;
       })));
-  const int n_threads = std::max(1, std::min<int>(inv.opts.jobs, static_cast<int>(todo.size())));
-  warn_oversubscribed(out, n_threads, inv.opts.np);
+  // A stage whose jobs start engine runs of their own (the calibrate
+  // stage's fits): every job at once, the engine runs limited instead.
+  const bool shared = p.stage.jobs_share_engine_runs();
+  const int n_threads =
+      std::max(1, shared ? static_cast<int>(todo.size())
+                         : std::min<int>(inv.opts.jobs, static_cast<int>(todo.size())));
+  warn_oversubscribed(out, shared ? inv.opts.jobs : n_threads, p.ctx.opts.np);
+  if (shared) p.ctx.runner.limit_runs(inv.opts.jobs);
+  struct Unlimit {
+    engine::Runner& r;
+    bool on;
+    ~Unlimit() {
+      if (on) r.limit_runs(0);
+    }
+  } unlimit{p.ctx.runner, shared};
   const PoolOutcome res = run_pool(p, todo, n_threads);
   for (const auto& f : res.failures) out << "error: " << f << "\n";
   for (const auto& b : res.busy) out << "warning: not run, " << b << "\n";
@@ -460,6 +477,19 @@ void print_read_stages(std::ostream& out, const std::vector<std::unique_ptr<Stag
 
 }  // namespace
 
+// The run options of one stage: its MPI ranks per engine run are --np when
+// given, else resources.<stage>.np when the case file sets it (as the Slurm
+// scripts read it: 400-element lab specimens and single impacts gain nothing
+// from two ranks that the flow wants), else resources.np.
+RunOptions stage_options(const config::CaseConfig& cfg, const Invocation& inv,
+                         const std::string& stage) {
+  RunOptions o = inv.opts;
+  const std::string key = "resources." + stage + ".np";
+  if (!inv.np_given && config::case_schema().find(key) && cfg.doc.line(key) > 0)
+    o.np = static_cast<int>(cfg.doc.integer(key));
+  return o;
+}
+
 int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostream& out) {
   auto stages = make_stages();
   engine::Runner runner;
@@ -490,7 +520,8 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
     if (!inv.dry_run && !inv.list_tasks)
       check_read_stages(stages, name, cfg, inv, runner, progress);
     Stage& stage = find_stage(stages, name);
-    StageContext ctx{cfg, inv.opts, run_dir, run_dir / name, runner, progress};
+    const RunOptions opts = stage_options(cfg, inv, name);
+    StageContext ctx{cfg, opts, run_dir, run_dir / name, runner, progress};
     const jobs::JobStore store(ctx.stage_dir);
     const Plan plan = stage.plan(ctx);
     check_unique_labels(name, plan);
@@ -502,7 +533,7 @@ int run_pipeline(const config::CaseConfig& cfg, const Invocation& inv, std::ostr
       continue;
     }
     if (inv.dry_run) {
-      print_plan(out, inv, stage, plan, rows);
+      print_plan(out, inv, ctx, stage, plan, rows);
       print_read_stages(out, stages, name, cfg, inv, runner, progress);
       continue;
     }

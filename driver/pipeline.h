@@ -23,6 +23,8 @@ enum ExitCode : int {
 struct Invocation {
   std::vector<std::string> stages;  // in pipeline order
   RunOptions opts;
+  bool np_given = false;  // --np on the command line: every stage's ranks (else
+                          // resources.<stage>.np when the case sets it, else resources.np)
   bool dry_run = false;
   bool list_tasks = false;
   std::optional<int> task;  // run only job I of the (single) stage

@@ -89,11 +89,18 @@ std::vector<KeyDef> stage_resources(const std::string& stage, const std::string&
   const std::string p = "resources." + stage + ".";
   std::vector<KeyDef> v;
   if (np_default == "-")
-    v.push_back(opt(at_least(
-        key(p + "np", KeyType::Int, "", "", "Cluster: MPI ranks per " + job + "; default: --np, else resources.np"), 1)));
+    v.push_back(
+        opt(at_least(key(p + "np", KeyType::Int, "", "",
+                         "Cluster: MPI ranks per " + job +
+                             "; default: --np, else resources.np. Set in the case file, also the "
+                             "ranks of this stage's engine runs on this machine (--np overrides)"),
+                     1)));
   else if (!np_default.empty())
     v.push_back(at_least(key(p + "np", KeyType::Int, "", np_default,
-                             "Cluster: MPI ranks per " + job + " (--np overrides when the stage is scripted alone)"),
+                             "Cluster: MPI ranks per " + job +
+                                 " (--np overrides when the stage is scripted alone). Set in the "
+                                 "case file, also the ranks of this stage's engine runs on this "
+                                 "machine (--np overrides; unset there: resources.np)"),
                          1));
   v.push_back(matching(
       key(p + "time", KeyType::String, "", time, "Cluster: wall-time limit of each " + job + " (--time overrides)"),

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <condition_variable>
 #include <cstdio>
 #include <cstring>
 #include <deque>
@@ -151,7 +152,65 @@ std::vector<std::string> Runner::scan_errors(const fs::path& log, Engine e) {
   return errs;
 }
 
+// The run slots of Runner::limit_runs: a ticket queue, so that runs start in
+// the order they asked (no fit starves while others take every free core).
+struct Runner::Slots {
+  std::mutex mu;
+  std::condition_variable cv;
+  int limit = 0;               // <= 0: no limit
+  int running = 0;             // runs holding a slot
+  unsigned long issued = 0;    // tickets handed out
+  unsigned long admitted = 0;  // tickets let through, in order
+};
+
+void Runner::limit_runs(int n) {
+  if (!slots_) slots_ = std::make_shared<Slots>();
+  std::lock_guard<std::mutex> g(slots_->mu);
+  slots_->limit = n;
+  slots_->cv.notify_all();
+}
+
+namespace {
+
+// A run slot held for the length of a run (nothing to hold without a limit).
+// A signal ends the wait unheld: the run then throws Interrupted, as every
+// other waiting run does.
+template <class S>
+class SlotHold {
+ public:
+  explicit SlotHold(S* s) : s_(s) {
+    if (!s_) return;
+    std::unique_lock<std::mutex> lk(s_->mu);
+    const unsigned long ticket = s_->issued++;
+    while (ticket != s_->admitted || (s_->limit > 0 && s_->running >= s_->limit)) {
+      if (pending_signal()) {
+        s_ = nullptr;
+        return;
+      }
+      s_->cv.wait_for(lk, std::chrono::milliseconds(200));
+    }
+    ++s_->admitted;
+    ++s_->running;
+    s_->cv.notify_all();
+  }
+  ~SlotHold() {
+    if (!s_) return;
+    std::lock_guard<std::mutex> g(s_->mu);
+    --s_->running;
+    s_->cv.notify_all();
+  }
+  SlotHold(const SlotHold&) = delete;
+  SlotHold& operator=(const SlotHold&) = delete;
+
+ private:
+  S* s_;
+};
+
+}  // namespace
+
 Result Runner::run(const Command& cmd, const Poll& poll) {
+  if (pending_signal()) throw Interrupted(pending_signal());
+  const SlotHold<Slots> slot_hold(slots_.get());
   if (pending_signal()) throw Interrupted(pending_signal());
   const auto argv_s = full_argv(cmd);
   if (argv_s.empty()) throw std::logic_error("Runner::run: empty command");

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -52,7 +53,15 @@ class Runner {
   using Poll = std::function<void(const std::filesystem::path& log)>;
 
   // Run and wait. Throws EngineError on failure, Interrupted on a signal.
+  // With a limit set (limit_runs), first waits for a free run slot; the
+  // wait is not part of Result::seconds.
   Result run(const Command& cmd, const Poll& poll = nullptr);
+
+  // At most n runs of this runner (and its copies) at once, from any
+  // number of threads; they start in the order they asked. n <= 0: no
+  // limit (the default). The calibrate stage runs all its fits at once
+  // and lets this hand out the cores (resources.jobs) run by run.
+  void limit_runs(int n);
 
   // The full argv actually executed (mpirun prefix included), for logs.
   static std::vector<std::string> full_argv(const Command& cmd);
@@ -62,6 +71,10 @@ class Runner {
 
   // Error lines the given engine writes in its log.
   static std::vector<std::string> scan_errors(const std::filesystem::path& log, Engine e);
+
+ private:
+  struct Slots;  // the run slots of limit_runs, shared by copies
+  std::shared_ptr<Slots> slots_;
 };
 
 // Runs a plotting script of postprocess/ with Debian's python3 (it has

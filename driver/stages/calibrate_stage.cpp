@@ -139,10 +139,12 @@ void Calibration::run() {
                   n_, 2e3 * sp.cyl_r, 4e3 * sp.cyl_r, 2e3 * sp.disc_r, 1e3 * sp.disc_r));
   const Targets& t = fit_.targets();
   LabBench lab(ctx_, job_.label, dir_, sp, t);
-  // resources.jobs engine runs at once, shared among the calibrate.starts
-  // fits (the stage's jobs, which the pipeline runs side by side): the rest
-  // go to this fit's independent tests (docs/calibration.md, "Runs at once").
-  lab.set_lanes(ctx_.opts.jobs / std::max<int>(1, static_cast<int>(d_.integer("calibrate.starts"))));
+  // Up to resources.jobs of this fit's independent tests at once; the
+  // calibrate.starts fits run side by side and the pipeline's runner hands
+  // out resources.jobs engine runs among them in the order they ask
+  // (CalibrateStage::jobs_share_engine_runs; docs/calibration.md, "Runs at
+  // once").
+  lab.set_lanes(ctx_.opts.jobs);
   // The fit's further packings (calibrate.fit_packings): each its own ball,
   // the same tests in every iteration; the fit reads the means.
   std::vector<LabBench> more;
@@ -243,19 +245,25 @@ void Calibration::run() {
                                              of + ": Brazilian", (at_j + 1) / steps_total});
         });
     }
-    run_concurrently(tests, lab.lanes());
+    // The bend test's half discs beside them: the same parameters.
+    std::vector<ScbDisc> discs;
     if (fit_.fits_toughness())
-      it.scb = lab.scb(p, rate_, scb_orientations_,
-                       {fmt::format("it{}_scb", k),
-                        fmt::format("iteration {}/{}: semi-circular bend", k, max_it_),
-                        (at + per_packing * fit_packings_) / steps_total});
+      for (auto& task :
+           lab.scb_tasks(p, rate_, scb_orientations_,
+                         {fmt::format("it{}_scb", k),
+                          fmt::format("iteration {}/{}: semi-circular bend", k, max_it_),
+                          (at + per_packing * fit_packings_) / steps_total},
+                         discs))
+        tests.push_back(std::move(task));
+    run_concurrently(tests, lab.lanes());
+    if (fit_.fits_toughness()) it.scb = ScbRun::of(std::move(discs));
     fit_.score(it);
     hist.push_back(it);
     const Measured m = it.measured();
     ctx_.progress.info(fmt::format(
         "[calibrate] iteration {}/{}: E {:.2f} GPa (target {:.2f}), nu {:.3f} ({:.2f}), UCS {:.1f} "
         "MPa ({:.1f}), {}tensile "
-        "{:.2f} MPa ({:.2f}){}{}{} [{:.0f} s + {:.0f} s{}{}]",
+        "{:.2f} MPa ({:.2f}){}{}{} [{:.0f} s + {:.0f} s{}{}{}]",
         k, max_it_, m.E / 1e9, t.E / 1e9, m.nu, t.nu, m.ucs / 1e6, t.ucs / 1e6,
         t.direct ? "direct " : "", m.tensile / 1e6, t.tensile / 1e6,
         more.empty() ? "" : fmt::format(" (means over {} packings)", fit_packings_),

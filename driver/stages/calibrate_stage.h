@@ -22,6 +22,9 @@ class CalibrateStage : public Stage {
   std::string damaged_outputs(const StageContext& ctx, const JobSpec& job) const override;
   std::string damaged_merged_outputs(const StageContext& ctx,
                                      const std::vector<JobSpec>& jobs) const override;
+  // The fits (calibrate.starts) run side by side, their lab runs drawing on
+  // resources.jobs engine runs in the order they ask.
+  bool jobs_share_engine_runs() const override { return true; }
 };
 
 }  // namespace mill

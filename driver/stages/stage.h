@@ -97,6 +97,13 @@ class Stage {
   // jobs it has (its plan can only be made once they have run).
   virtual std::vector<std::string> reads(const config::CaseConfig& /*cfg*/) const { return {}; }
   virtual std::vector<std::string> jobs_from(const config::CaseConfig& /*cfg*/) const { return {}; }
+  // True for a stage whose jobs each start several engine runs of their own
+  // (the calibrate stage's fits): the pipeline then runs all its jobs at
+  // once and limits the engine runs, not the jobs, to RunOptions::jobs
+  // (engine::Runner::limit_runs), so that no core idles while one job waits
+  // for its own runs. Each job may then ask for up to RunOptions::jobs runs
+  // at once.
+  virtual bool jobs_share_engine_runs() const { return false; }
 };
 
 // The stages in pipeline order: flow, sample, transport, calibrate, breakage, report.

@@ -100,6 +100,30 @@ TEST(Cli, DryRunListsEveryStageOfBothCases) {
   EXPECT_NE(ref.text.find("39 jobs"), std::string::npos) << ref.text;  // 13 speeds x 3 repeats
 }
 
+// resources.<stage>.np set in the case file is that stage's ranks on this
+// machine too (the reference case: np 2 for the flow, 1 for the calibration
+// and the impacts); --np overrides it; a stage without it keeps resources.np.
+TEST(Cli, StageRanksFromTheCaseUnlessNpIsGiven) {
+  const std::string ref = "--case " + kProject + "/cases/reference.yaml --dry-run --stage ";
+  const auto cal = orchestrate(ref + "calibrate");
+  EXPECT_EQ(cal.status, 0) << cal.text;
+  EXPECT_NE(cal.text.find("2 MPI rank(s) each"), std::string::npos) << cal.text;  // resources.np
+  EXPECT_NE(cal.text.find("1 MPI rank(s) per engine run (resources.calibrate.np)"),
+            std::string::npos)
+      << cal.text;
+  const auto brk = orchestrate(ref + "breakage");
+  EXPECT_NE(brk.text.find("1 MPI rank(s) per engine run (resources.breakage.np)"),
+            std::string::npos)
+      << brk.text;
+  for (const std::string& args :
+       {ref + "flow", ref + "calibrate --np 2", ref + "breakage --np 3"}) {
+    const auto o = orchestrate(args);
+    EXPECT_EQ(o.status, 0) << o.text;
+    EXPECT_EQ(o.text.find("per engine run (resources."), std::string::npos) << args << "\n"
+                                                                            << o.text;
+  }
+}
+
 TEST(Cli, ListTasksOneLinePerJob) {
   auto o = orchestrate("--case " + kData + "/good_small.yaml --stage breakage --list-tasks");
   EXPECT_EQ(o.status, 0);

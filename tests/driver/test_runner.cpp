@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "engine/runner.h"
 #include "temp_dir.h"
@@ -123,6 +125,45 @@ TEST(Runner, EnvironmentReachesChild) {
   std::string line;
   std::getline(in, line);
   EXPECT_EQ(line, "forty-two");
+}
+
+// limit_runs: runs from many threads (through copies of one runner) never
+// exceed the limit at once, and reach it; a limit of 0 lets them all run.
+// Each run appends "+" to a shared file when it starts and "-" when it ends
+// (O_APPEND lines); the most "+" lines open at once is the concurrency.
+int most_at_once(const fs::path& d, Runner& r, int runs) {
+  const fs::path f = d / "events.txt";
+  std::vector<std::thread> threads;
+  for (int k = 0; k < runs; ++k)
+    threads.emplace_back([&, k] {
+      Runner copy = r;
+      Command c = sh(d, "echo + >> " + f.string() + "; sleep 0.6; echo - >> " + f.string());
+      c.log = d / ("log" + std::to_string(k) + ".txt");
+      copy.run(c);
+    });
+  for (auto& t : threads) t.join();
+  std::ifstream in(f);
+  std::string line;
+  int open = 0, most = 0, ends = 0;
+  while (std::getline(in, line)) {
+    open += line == "+" ? 1 : -1;
+    ends += line == "-" ? 1 : 0;
+    most = std::max(most, open);
+  }
+  EXPECT_EQ(ends, runs);
+  fs::remove(f);
+  return most;
+}
+
+TEST(Runner, LimitRunsCapsTheRunsAtOnceAcrossThreadsAndCopies) {
+  const auto d = fresh_dir("limit");
+  Runner r;
+  r.limit_runs(2);
+  EXPECT_EQ(most_at_once(d, r, 6), 2);
+  r.limit_runs(1);
+  EXPECT_EQ(most_at_once(d, r, 3), 1);
+  r.limit_runs(0);
+  EXPECT_GE(most_at_once(d, r, 3), 2) << "without a limit the runs should overlap";
 }
 
 // SIGTERM to orchestrate is forwarded to the engine, which sees it (trap),

@@ -188,33 +188,43 @@ void check_scb_layers(const std::map<std::string, double>& info,
 // peak taken as the Brazilian disc's (4 tensile / E), the cap ten times as
 // far: bending is more compliant.
 ScbRun LabBench::scb(const BondParams& p, double rate, int orientations, const RunStep& step) {
+  std::vector<ScbDisc> discs;
+  run_concurrently(scb_tasks(p, rate, orientations, step, discs), lanes_);
+  return ScbRun::of(std::move(discs));
+}
+
+std::vector<std::function<void()>> LabBench::scb_tasks(const BondParams& p, double rate,
+                                                       int orientations, const RunStep& step,
+                                                       std::vector<ScbDisc>& discs) {
   if (orientations < 1)
     throw std::runtime_error(
         fmt::format("calibrate.scb_orientations: expected at least 1, got {}", orientations));
-  std::vector<ScbDisc> discs(static_cast<std::size_t>(orientations));
+  discs.assign(static_cast<std::size_t>(orientations), ScbDisc{});
   std::vector<std::function<void()>> tasks;
-  for (int k = 0; k < orientations; ++k) tasks.push_back([&, k] {
-    ScbDisc& d = discs[static_cast<std::size_t>(k)];
-    d.angle_deg = 180.0 * k / orientations;
-    const RunStep disc_step{
-        k == 0 ? step.tag : fmt::format("{}_o{}", step.tag, k),
-        orientations == 1 ? step.what : fmt::format("{} {}/{}", step.what, k + 1, orientations),
-        step.done};
-    const fs::path work = run_test({"scb",
-                                    kScbRadiusFactor * sp_.disc_r,
-                                    4.0 * t_.disc_tensile() / t_.E,
-                                    10.0,
-                                    {{"carve_angle", num(d.angle_deg)}}},
-                                   p, rate, disc_step, d);
-    check_scb_layers(d.info, d.info_file);
-    d.curve = post::ReadLoadCurve((work / "scb_curve.txt").string());
-    d.r = post::AnalyseScb(
-        d.curve, info_at(d.info, "radius", d.info_file), info_at(d.info, "thickness", d.info_file),
-        info_at(d.info, "notch", d.info_file), info_at(d.info, "half_span", d.info_file));
-    d.peaked = d.r.peak_index + 1 < d.curve.size();
-  });
-  run_concurrently(tasks, lanes_);
-  return ScbRun::of(std::move(discs));
+  // Copies of what the tasks read: they run after this returns.
+  for (int k = 0; k < orientations; ++k)
+    tasks.push_back([this, &discs, p, rate, orientations, step, k] {
+      ScbDisc& d = discs[static_cast<std::size_t>(k)];
+      d.angle_deg = 180.0 * k / orientations;
+      const RunStep disc_step{
+          k == 0 ? step.tag : fmt::format("{}_o{}", step.tag, k),
+          orientations == 1 ? step.what : fmt::format("{} {}/{}", step.what, k + 1, orientations),
+          step.done};
+      const fs::path work = run_test({"scb",
+                                      kScbRadiusFactor * sp_.disc_r,
+                                      4.0 * t_.disc_tensile() / t_.E,
+                                      10.0,
+                                      {{"carve_angle", num(d.angle_deg)}}},
+                                     p, rate, disc_step, d);
+      check_scb_layers(d.info, d.info_file);
+      d.curve = post::ReadLoadCurve((work / "scb_curve.txt").string());
+      d.r = post::AnalyseScb(d.curve, info_at(d.info, "radius", d.info_file),
+                             info_at(d.info, "thickness", d.info_file),
+                             info_at(d.info, "notch", d.info_file),
+                             info_at(d.info, "half_span", d.info_file));
+      d.peaked = d.r.peak_index + 1 < d.curve.size();
+    });
+  return tasks;
 }
 
 ScbRun ScbRun::of(std::vector<ScbDisc> discs) {

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -150,10 +151,17 @@ class LabBench {
   // x the Brazilian disc's radius), the ball turned by 180 deg / orientations
   // about the load axis from one to the next; tags <step.tag>, <step.tag>_o1, ...
   ScbRun scb(const BondParams& p, double rate, int orientations, const RunStep& step);
+  // The same half discs as tasks, for a caller that runs them side by side
+  // with other tests (run_concurrently): each task fills its entry of
+  // `discs` (resized here to `orientations`); ScbRun::of(discs) then gives
+  // what scb() returns.
+  std::vector<std::function<void()>> scb_tasks(const BondParams& p, double rate, int orientations,
+                                               const RunStep& step, std::vector<ScbDisc>& discs);
 
   // How many lab runs the job may have going at once (the half discs of a
   // bend test; callers run independent tests side by side with
-  // run_concurrently): resources.jobs shared among the stage's jobs.
+  // run_concurrently): resources.jobs; the stage's runner shares that many
+  // engine runs among the stage's fits (docs/calibration.md, "Runs at once").
   // Each run writes its own folder, so the results do not depend on it.
   int lanes() const { return lanes_; }
   void set_lanes(int lanes) { lanes_ = lanes < 1 ? 1 : lanes; }
