@@ -161,6 +161,26 @@ struct Runner::Slots {
   int running = 0;             // runs holding a slot
   unsigned long issued = 0;    // tickets handed out
   unsigned long admitted = 0;  // tickets let through, in order
+
+  // Waits for this caller's turn and a free slot; false when a signal ends
+  // the wait (the run then throws Interrupted, as every waiting run does).
+  bool acquire() {
+    std::unique_lock<std::mutex> lk(mu);
+    const unsigned long ticket = issued++;
+    while (ticket != admitted || (limit > 0 && running >= limit)) {
+      if (pending_signal()) return false;
+      cv.wait_for(lk, std::chrono::milliseconds(200));
+    }
+    ++admitted;
+    ++running;
+    cv.notify_all();
+    return true;
+  }
+  void release() {
+    std::lock_guard<std::mutex> g(mu);
+    --running;
+    cv.notify_all();
+  }
 };
 
 void Runner::limit_runs(int n) {
@@ -170,47 +190,14 @@ void Runner::limit_runs(int n) {
   slots_->cv.notify_all();
 }
 
-namespace {
-
-// A run slot held for the length of a run (nothing to hold without a limit).
-// A signal ends the wait unheld: the run then throws Interrupted, as every
-// other waiting run does.
-template <class S>
-class SlotHold {
- public:
-  explicit SlotHold(S* s) : s_(s) {
-    if (!s_) return;
-    std::unique_lock<std::mutex> lk(s_->mu);
-    const unsigned long ticket = s_->issued++;
-    while (ticket != s_->admitted || (s_->limit > 0 && s_->running >= s_->limit)) {
-      if (pending_signal()) {
-        s_ = nullptr;
-        return;
-      }
-      s_->cv.wait_for(lk, std::chrono::milliseconds(200));
-    }
-    ++s_->admitted;
-    ++s_->running;
-    s_->cv.notify_all();
-  }
-  ~SlotHold() {
-    if (!s_) return;
-    std::lock_guard<std::mutex> g(s_->mu);
-    --s_->running;
-    s_->cv.notify_all();
-  }
-  SlotHold(const SlotHold&) = delete;
-  SlotHold& operator=(const SlotHold&) = delete;
-
- private:
-  S* s_;
-};
-
-}  // namespace
-
 Result Runner::run(const Command& cmd, const Poll& poll) {
-  if (pending_signal()) throw Interrupted(pending_signal());
-  const SlotHold<Slots> slot_hold(slots_.get());
+  // A run slot for the length of the run (none to hold without a limit).
+  struct SlotHold {
+    Slots* s;
+    ~SlotHold() {
+      if (s) s->release();
+    }
+  } const slot_hold{slots_ && slots_->acquire() ? slots_.get() : nullptr};
   if (pending_signal()) throw Interrupted(pending_signal());
   const auto argv_s = full_argv(cmd);
   if (argv_s.empty()) throw std::logic_error("Runner::run: empty command");
