@@ -157,10 +157,9 @@ StageResources stage_resources(const config::CaseConfig& cfg, const HpcOptions& 
   if (config::case_schema().find(p + "np")) {  // a stage that runs MPI engines
     if (o.np > 0 && (stage == "flow" || o.stages.size() == 1))
       r.np = o.np;
-    else if (d.has(p + "np"))
-      r.np = static_cast<int>(d.integer(p + "np"));
     else
-      r.np = static_cast<int>(d.integer("resources.np"));
+      r.np = config::stage_np(d, stage, /*default_counts=*/true)
+                 .value_or(static_cast<int>(d.integer("resources.np")));
   }
   // An option given on the command line, else the case's key (or none).
   auto pick = [&](const std::string& opt_value, const char* opt_name, const std::string& key,

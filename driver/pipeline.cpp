@@ -484,9 +484,8 @@ void print_read_stages(std::ostream& out, const std::vector<std::unique_ptr<Stag
 RunOptions stage_options(const config::CaseConfig& cfg, const Invocation& inv,
                          const std::string& stage) {
   RunOptions o = inv.opts;
-  const std::string key = "resources." + stage + ".np";
-  if (!inv.np_given && config::case_schema().find(key) && cfg.doc.line(key) > 0)
-    o.np = static_cast<int>(cfg.doc.integer(key));
+  if (inv.np_given) return o;
+  if (const auto np = config::stage_np(cfg.doc, stage, /*default_counts=*/false)) o.np = *np;
   return o;
 }
 
@@ -634,14 +633,19 @@ int run_single_impact(const config::CaseConfig& cfg, const RunOptions& opts, dou
                             angle, opts.output.string()));
   progress.stage_begin("impact", 1, 0);
   store.mark_running(label, inputs);
+  progress.job_begin(label);  // the job's clock: its ETA
+  const auto t0 = std::chrono::steady_clock::now();
   std::string line;
   try {
     line = breakage::run_impact(ctx, velocity, angle, repeat, opts.output, label);
   } catch (const std::exception& e) {
     const std::string why = e.what();
+    progress.job_end(label, false, 0);
     store.mark_failed(label, why.substr(0, why.find('\n')));
     throw;
   }
+  progress.job_end(label, true,
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   store.mark_done(label);
   progress.stage_end();
   out << line << "\n"

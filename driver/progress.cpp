@@ -116,6 +116,9 @@ void Progress::job_begin(const std::string& label) {
 void Progress::job_step(const std::string& label, const std::string& what, double fraction) {
   std::lock_guard<std::mutex> g(mu_);
   running_[label] = {what, fraction};
+  // A job stepped without job_begin starts its clock here: counted from
+  // zero seconds it would project an ETA of 0 s.
+  started_.emplace(label, std::chrono::steady_clock::now());
   draw(false);
 }
 

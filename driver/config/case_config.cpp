@@ -846,6 +846,13 @@ fs::path resolve_ore(const Document& d, const fs::path& case_file, const fs::pat
 
 }  // namespace
 
+std::optional<int> stage_np(const Document& d, const std::string& stage, bool default_counts) {
+  const std::string key = "resources." + stage + ".np";
+  if (!case_schema().find(key)) return std::nullopt;  // a stage without MPI engines
+  if (default_counts ? !d.has(key) : d.line(key) == 0) return std::nullopt;
+  return static_cast<int>(d.integer(key));
+}
+
 nlohmann::json outliers(const CaseConfig& c) {
   nlohmann::json all = c.doc.outliers();
   for (const auto& o : c.ore.outliers()) all.push_back(o);

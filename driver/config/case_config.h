@@ -74,6 +74,12 @@ struct CaseConfig {
 CaseConfig load_case(const std::filesystem::path& file, const std::filesystem::path& project_dir,
                      const std::vector<std::pair<std::string, std::string>>& overrides = {});
 
+// resources.<stage>.np of a stage that runs MPI engines: on a cluster
+// (`default_counts`: the Slurm scripts) also its schema default, on this
+// machine only when the case file sets it (the flow keeps resources.np).
+// None: the caller's ranks (--np, else resources.np).
+std::optional<int> stage_np(const Document& d, const std::string& stage, bool default_counts);
+
 // The values of the case and its ore card kept outside their plausible range
 // (allow_outside_range), for resolved_case.json and the report.
 nlohmann::json outliers(const CaseConfig& c);

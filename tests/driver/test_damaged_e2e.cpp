@@ -185,6 +185,11 @@ TEST(ImpactRerun, IdenticalImpactIsNotRedone) {
   const auto dir = scratch("impact_rerun");
   const std::string args = "impact --velocity 20 --elements 50 --output " + (dir / "out").string();
   ASSERT_EQ(orchestrate(args, dir / "first.log"), 0) << slurp(dir / "first.log");
+  // The job is begun and ended in the progress (its ETA counts from its start).
+  EXPECT_NE(slurp(dir / "first.log").find("[impact] start impact_v20_a90_r0"), std::string::npos)
+      << slurp(dir / "first.log");
+  EXPECT_NE(slurp(dir / "first.log").find("[impact] done impact_v20_a90_r0 in "), std::string::npos)
+      << slurp(dir / "first.log");
   const auto t0 = fs::last_write_time(dir / "out/result.json");
   ASSERT_EQ(orchestrate(args, dir / "second.log"), 0) << slurp(dir / "second.log");
   EXPECT_NE(slurp(dir / "second.log").find("already done with the same inputs"), std::string::npos)

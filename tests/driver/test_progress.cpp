@@ -2,8 +2,10 @@
 // engine::deck_progress: how far a running deck is, from its log.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <sstream>
+#include <thread>
 
 #include "engine/liggghts.h"
 #include "progress.h"
@@ -42,6 +44,22 @@ TEST(ProgressEta, NoInformationGivesNoEstimate) {
 TEST(ProgressEta, ProjectedRunningJobsStandInForTheMean) {
   // one job at 25 % after 10 s: 30 s left, 40 s in all; 2 queued at 40 s each, 1 slot
   EXPECT_NEAR(Progress::eta_seconds({{10.0, 0.25}}, 2, 0, 0.0, 1), 110.0, 1e-9);
+}
+
+// A job that reports steps without job_begin (a caller that forgot it) is
+// timed from its first step: counted from zero seconds it would show "ETA 0s"
+// for the whole run (the impact subcommand did, Nov 29). 50 % at its first
+// step, 60 % a second later: 0.67-1 s left, printed "1s".
+TEST(ProgressEta, AJobSteppedWithoutBeginIsTimedFromItsFirstStep) {
+  std::ostringstream out;
+  Progress p(out, /*tty=*/false, /*heartbeat_seconds=*/0.0);
+  p.stage_begin("impact", 1, 0);
+  p.job_step("impact_v4_a90_r0", "step 500/1000", 0.5);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1050));
+  p.job_step("impact_v4_a90_r0", "step 600/1000", 0.6);
+  const std::string text = out.str();
+  const std::string last = text.substr(text.rfind("[impact]"));
+  EXPECT_NE(last.find("ETA 1s"), std::string::npos) << text;
 }
 
 // A deck log as the impact deck writes it: a thermo line with another
