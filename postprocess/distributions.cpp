@@ -179,13 +179,29 @@ bool BelowAtSlowest(const std::vector<SweepPoint>& points, double threshold) {
 }
 
 // Critical velocity of the mean curve and of each repeat.
+std::set<int> RepeatsAtEveryVelocity(const std::vector<SweepPoint>& points) {
+  std::map<double, std::set<int>> at;  // velocity -> its repeat ids
+  for (const SweepPoint& p : points) at[p.velocity_m_s].insert(p.repeat);
+  if (at.empty()) return {};
+  std::set<int> every = at.begin()->second;
+  for (const auto& [v, ids] : at) {
+    std::set<int> both;
+    std::set_intersection(every.begin(), every.end(), ids.begin(), ids.end(),
+                          std::inserter(both, both.begin()));
+    every = std::move(both);
+  }
+  return every;
+}
+
 CriticalVelocity FindCriticalVelocity(const std::vector<SweepPoint>& points, double threshold) {
   CriticalVelocity out;
+  const std::set<int> whole = RepeatsAtEveryVelocity(points);
   std::vector<double> v_all, y_all;
   std::map<int, std::pair<std::vector<double>, std::vector<double>>> by_repeat;
   for (const SweepPoint& p : points) {
     v_all.push_back(p.velocity_m_s);
     y_all.push_back(p.value);
+    if (!whole.count(p.repeat)) continue;  // a repeat at some speeds only: the mean curve's
     by_repeat[p.repeat].first.push_back(p.velocity_m_s);
     by_repeat[p.repeat].second.push_back(p.value);
   }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <optional>
+#include <set>
 #include <vector>
 
 namespace mill::post {
@@ -70,8 +71,15 @@ struct CriticalVelocity {
   int n_crossed = 0;                              // repeats whose curve falls below
 };
 
+// The repeat ids present at every velocity of the points: the repeats whose
+// own curve spans the sweep. A sweep with more repeats at some speeds
+// (breakage.crossing_velocities) has further repeats only there.
+std::set<int> RepeatsAtEveryVelocity(const std::vector<SweepPoint>& points);
+
 // The critical velocity where the largest-piece fraction first falls below
-// `threshold` (method.md: "shattered"), for the points of one impact angle.
+// `threshold` (method.md: "shattered"), for the points of one impact angle:
+// the repeat-averaged curve from every point; the per-repeat curves (and
+// their spread) of the repeats at every velocity only.
 // stddev is the sample standard deviation (n-1), absent for fewer than two.
 CriticalVelocity FindCriticalVelocity(const std::vector<SweepPoint>& points, double threshold);
 

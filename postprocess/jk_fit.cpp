@@ -181,13 +181,14 @@ JkFit FitJk(const std::vector<double>& e, const std::vector<double>& t) {
 }
 
 // Pooled fit and one fit per repeat.
-JkSweepFit FitJkSweep(const std::vector<JkPoint>& points) {
+JkSweepFit FitJkSweep(const std::vector<JkPoint>& points, const std::set<int>* whole) {
   JkSweepFit out;
   std::vector<double> e, t;
   std::map<int, std::pair<std::vector<double>, std::vector<double>>> by_repeat;
   for (const JkPoint& p : points) {
     e.push_back(p.ecs_kwh_t);
     t.push_back(p.t10_percent);
+    if (whole && !whole->count(p.repeat)) continue;  // pooled only
     by_repeat[p.repeat].first.push_back(p.ecs_kwh_t);
     by_repeat[p.repeat].second.push_back(p.t10_percent);
   }

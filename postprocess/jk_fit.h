@@ -8,6 +8,7 @@
 #pragma once
 
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -73,6 +74,8 @@ struct JkSweepFit {
   std::optional<Spread> a_percent, b_t_per_kwh, ab;
 };
 
-JkSweepFit FitJkSweep(const std::vector<JkPoint>& points);
+// `whole`, when given: the repeats fitted on their own (those at every speed
+// of the sweep, RepeatsAtEveryVelocity); the others count in the pooled fit only.
+JkSweepFit FitJkSweep(const std::vector<JkPoint>& points, const std::set<int>* whole = nullptr);
 
 }  // namespace mill::post

@@ -576,6 +576,27 @@ void check_physics(const Document& d) {
           d.where("breakage.strength_velocities")));
   }
   check_unique_items(d, "breakage.angles", "deg");
+  if (d.has("breakage.crossing_velocities")) {
+    check_unique_items(d, "breakage.crossing_velocities", "m/s");
+    const std::string where = d.where("breakage.crossing_velocities");
+    if (d.str("breakage.conditions") != "sweep")
+      throw ConfigError(fmt::format(
+          "{}: more repeats at speeds of the sweep, and breakage.conditions is {}; expected it "
+          "absent, or breakage.conditions: sweep",
+          where, d.str("breakage.conditions")));
+    const auto sweep = d.reals("breakage.velocities");
+    for (double v : d.reals("breakage.crossing_velocities"))
+      if (std::find(sweep.begin(), sweep.end(), v) == sweep.end())
+        throw ConfigError(fmt::format(
+            "{}: {} m/s is not a speed of breakage.velocities; expected speeds of the sweep "
+            "(add {} to breakage.velocities, or drop it here)",
+            where, num(v), num(v)));
+    if (d.integer("breakage.crossing_repeats") < d.integer("breakage.repeats"))
+      throw ConfigError(fmt::format(
+          "{}: {} repeats at the crossing, fewer than breakage.repeats ({}); expected at least {}",
+          d.where("breakage.crossing_repeats"), d.integer("breakage.crossing_repeats"),
+          d.integer("breakage.repeats"), d.integer("breakage.repeats")));
+  }
 
   // The lump against the beaters: a plate reaches (D - hub) / 2 from the hub.
   const double plate = (D - hub) / 2;
@@ -674,6 +695,10 @@ void check_job_count(const Document& d) {
     const double nv = static_cast<double>(d.reals("breakage.velocities").size());
     const double na = static_cast<double>(d.reals("breakage.angles").size());
     jobs = nv * na * repeats;
+    if (d.has("breakage.crossing_velocities"))  // (only sweep speeds: checked before)
+      jobs += static_cast<double>(d.reals("breakage.crossing_velocities").size()) * na *
+              static_cast<double>(d.integer("breakage.crossing_repeats") -
+                                  d.integer("breakage.repeats"));
     how = fmt::format("breakage.velocities ({}) x breakage.angles ({}) x breakage.repeats ({})", nv, na, repeats);
     factors = {{"breakage.velocities", nv}, {"breakage.angles", na}, {"breakage.repeats", repeats}};
   } else {

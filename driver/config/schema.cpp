@@ -366,6 +366,18 @@ std::vector<KeyDef> breakage_keys() {
       at_least(
           key("breakage.repeats", T::Int, "", "1", "Repeats per condition (random orientation)"),
           1),
+      opt(range(key("breakage.crossing_velocities", T::RealList, "m/s", "",
+                    "sweep conditions: speeds of breakage.velocities run "
+                    "breakage.crossing_repeats times instead of breakage.repeats: those where "
+                    "the largest piece crosses breakage.critical_largest_fraction. There the "
+                    "curve is flat and one repeat moves the critical speed by several m/s "
+                    "(docs/breakage.md, \"Repeats at the crossing\"); the per-repeat spreads "
+                    "read the repeats every speed has; absent = none"),
+                0, true, 500, false)),
+      at_least(key("breakage.crossing_repeats", T::Int, "", "6",
+                   "Repeats of each speed in breakage.crossing_velocities (at least "
+                   "breakage.repeats)"),
+               1),
       positive(key("breakage.duration_after_contact", T::Real, "s", "6e-3",
                    "Simulated time after first contact, at most")),
       at_least(key("breakage.quiet_time", T::Real, "s", "1e-3",

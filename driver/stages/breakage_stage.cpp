@@ -70,12 +70,18 @@ bool plan_binned(const StageContext& ctx, const nlohmann::json& base, double rpm
 }
 
 // The impacts of the case's own sweep: breakage.velocities x breakage.angles
-// x breakage.repeats.
+// x breakage.repeats, breakage.crossing_repeats at breakage.crossing_velocities.
 void plan_sweep(const StageContext& ctx, const nlohmann::json& base, Plan& p) {
   const auto& d = ctx.cfg.doc;
+  const std::vector<double> crossing = d.has("breakage.crossing_velocities")
+                                           ? d.reals("breakage.crossing_velocities")
+                                           : std::vector<double>{};
   for (double v : d.reals("breakage.velocities"))
-    for (double a : d.reals("breakage.angles"))
-      for (long r = 0; r < d.integer("breakage.repeats"); ++r) {
+    for (double a : d.reals("breakage.angles")) {
+      const bool at_crossing = std::find(crossing.begin(), crossing.end(), v) != crossing.end();
+      const long repeats =
+          d.integer(at_crossing ? "breakage.crossing_repeats" : "breakage.repeats");
+      for (long r = 0; r < repeats; ++r) {
         engine::throw_if_interrupted();  // a plan of many jobs stops on SIGINT/SIGTERM
         nlohmann::json in = base;
         in["velocity"] = v;
@@ -85,6 +91,7 @@ void plan_sweep(const StageContext& ctx, const nlohmann::json& base, Plan& p) {
                           fmt::format("{}-element lump at {:g} m/s, {:g} deg, repeat {}",
                                       d.integer("lump.n_elements"), v, a, r)});
       }
+    }
 }
 
 // With transport conditions, the strength impacts

@@ -97,7 +97,10 @@ TEST(Cli, DryRunListsEveryStageOfBothCases) {
   EXPECT_NE(orchestrate("--case " + kProject + "/cases/reference.yaml --stage all --dry-run").text.find("v169_a90_r0"),
             std::string::npos);
   auto ref = orchestrate("--case " + kProject + "/cases/reference.yaml --stage breakage --dry-run");
-  EXPECT_NE(ref.text.find("39 jobs"), std::string::npos) << ref.text;  // 13 speeds x 3 repeats
+  // 14 speeds x 3 repeats, and 3 more at each of the 3 crossing speeds (30, 35, 40 m/s)
+  EXPECT_NE(ref.text.find("51 jobs"), std::string::npos) << ref.text;
+  EXPECT_NE(ref.text.find("v35_a90_r5"), std::string::npos) << ref.text;
+  EXPECT_EQ(ref.text.find("v50_a90_r3"), std::string::npos) << ref.text;
 }
 
 // resources.<stage>.np set in the case file is that stage's ranks on this
@@ -131,6 +134,24 @@ TEST(Cli, ListTasksOneLinePerJob) {
   for (char ch : o.text) lines += ch == '\n';
   EXPECT_EQ(lines, 4) << o.text;  // 2 speeds x 2 repeats
   EXPECT_EQ(o.text.rfind("0\tv5_a90_r0\t", 0), 0u) << o.text;
+}
+
+// breakage.crossing_velocities: those speeds of the sweep run
+// breakage.crossing_repeats times, the others breakage.repeats times.
+TEST(Cli, CrossingVelocitiesGetTheirOwnRepeats) {
+  const mill::test::TempDir dir("mill_cli_crossing_" + std::to_string(getpid()));
+  const fs::path yaml = dir.path() / "crossing.yaml";
+  std::ofstream(yaml)
+      << "name: crossing\nlump: {n_elements: 200}\n"
+         "breakage:\n  velocities: [5, 20, 50]\n  repeats: 2\n"
+         "  crossing_velocities: [20]\n  crossing_repeats: 5\nore: {card: sandstone}\n";
+  auto o = orchestrate("--case " + yaml.string() + " --stage breakage --list-tasks");
+  ASSERT_EQ(o.status, 0) << o.text;
+  EXPECT_EQ(std::count(o.text.begin(), o.text.end(), '\n'), 2 + 5 + 2) << o.text;
+  for (const char* label : {"v5_a90_r1\t", "v20_a90_r4\t", "v50_a90_r1\t"})
+    EXPECT_NE(o.text.find(label), std::string::npos) << label << "\n" << o.text;
+  EXPECT_EQ(o.text.find("v5_a90_r2"), std::string::npos) << o.text;
+  EXPECT_EQ(o.text.find("v20_a90_r5"), std::string::npos) << o.text;
 }
 
 // --task narrows --list-tasks and --dry-run to its job.

@@ -1,11 +1,11 @@
 // Size fractions, t10 and the critical velocity on hand-made data.
-#include "postprocess/distributions.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numeric>
+#include <set>
 
+#include "postprocess/distributions.h"
 #include "postprocess/fragments.h"
 
 namespace mill::post {
@@ -89,6 +89,27 @@ TEST(CriticalVelocity, SpreadOverRepeats) {
   EXPECT_NEAR(*c.min, 20.0 + 2.0 / 0.28, 1e-12);
   EXPECT_NEAR(*c.max, 28.0, 1e-12);
   EXPECT_NEAR(*c.stddev, (28.0 - (20.0 + 2.0 / 0.28)) / std::sqrt(2.0), 1e-12);
+}
+
+// More repeats at the speeds around the crossing (breakage.crossing_velocities):
+// repeats 0-1 at 10, 20 and 30 m/s, repeats 2-3 at 20 and 30 only. The mean
+// curve averages all four at 20 and 30 (20: 0.45, 30: 0.0); the per-repeat
+// spread reads repeats 0 and 1 only (a curve from 20 m/s up would put repeat
+// 3, below 0.1 at 20 m/s already, at 20 m/s: a crossing it never showed).
+TEST(CriticalVelocity, RepeatsAtSomeSpeedsOnlyCountInTheMeanCurveNotTheSpread) {
+  const std::vector<SweepPoint> pts = {{10, 0, 1.0},  {20, 0, 0.5}, {30, 0, 0.0},  {10, 1, 1.0},
+                                       {20, 1, 0.3},  {30, 1, 0.0}, {20, 2, 0.95}, {30, 2, 0.0},
+                                       {20, 3, 0.05}, {30, 3, 0.0}};
+  EXPECT_EQ(RepeatsAtEveryVelocity(pts), (std::set<int>{0, 1}));
+  const auto c = FindCriticalVelocity(pts, 0.1);
+  EXPECT_EQ(c.repeats, (std::vector<int>{0, 1}));
+  ASSERT_EQ(c.per_repeat.size(), 2u);
+  EXPECT_NEAR(*c.per_repeat[0], 28.0, 1e-12);
+  EXPECT_NEAR(*c.per_repeat[1], 20.0 + 2.0 / 0.3, 1e-12);
+  EXPECT_NEAR(*c.of_mean_curve, 20.0 + 3.5 / 0.45, 1e-12);  // (0.5+0.3+0.95+0.05)/4 = 0.45
+  EXPECT_EQ(c.n_crossed, 2);
+  EXPECT_NEAR(*c.min, 20.0 + 2.0 / 0.3, 1e-12);
+  EXPECT_EQ(RepeatsAtEveryVelocity({}), std::set<int>{});
 }
 
 // The repeat-averaged curve (10: 1.0, 20: 0.4, 30: 0.01) read between and at

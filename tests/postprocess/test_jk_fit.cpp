@@ -1,11 +1,11 @@
 // The JK t10-Ecs fit on synthetic sweeps with known A and b.
-#include "postprocess/jk_fit.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
 
 #include "postprocess/fragments.h"
+#include "postprocess/jk_fit.h"
 
 namespace mill::post {
 namespace {
@@ -109,6 +109,24 @@ TEST(JkFit, ARepeatWithTooFewPointsIsLeftOutOfTheSpread) {
   ASSERT_EQ(s.per_repeat.size(), 2u);
   EXPECT_FALSE(s.per_repeat[1].ok);
   EXPECT_FALSE(s.a_percent->stddev);  // one repeat: no standard deviation
+}
+
+// Repeats 1-2 at two of the four energies only (more repeats at the speeds
+// of the crossing): pooled with the others, not fitted on their own when the
+// repeats at every speed are given; without them they would be.
+TEST(JkFit, RepeatsAtSomeSpeedsOnlyArePooledNotFittedOnTheirOwn) {
+  std::vector<JkPoint> pts;
+  for (double e : {0.1, 0.3, 0.9, 2.0}) pts.push_back({e, JkT10(40, 1.2, e), 0});
+  for (int r : {1, 2})
+    for (double e : {0.3, 0.9}) pts.push_back({e, JkT10(40, 1.2, e) * (r == 1 ? 1.02 : 0.98), r});
+  const std::set<int> whole = {0};
+  const JkSweepFit s = FitJkSweep(pts, &whole);
+  ASSERT_TRUE(s.pooled.ok) << s.pooled.reason;
+  EXPECT_NEAR(s.pooled.a_percent, 40.0, 0.05 * 40.0);  // every point pooled
+  EXPECT_EQ(s.repeats, (std::vector<int>{0}));
+  EXPECT_EQ(s.n_repeats_fitted, 1);
+  EXPECT_NEAR(s.a_percent->mean, 40.0, 1e-3 * 40.0);  // repeat 0: exact data
+  EXPECT_EQ(FitJkSweep(pts).repeats, (std::vector<int>{0, 1, 2}));
 }
 
 }  // namespace

@@ -81,7 +81,12 @@ void write_jk_fit(StageContext& ctx, const std::vector<post::ImpactSummary>& row
       csv += fmt::format("{:g},{:g},{},{:.9g},{:.9g},{}\n", s->angle_deg, s->velocity_m_s,
                          s->repeat, e, s->t10_percent, s->t10_resolved ? 1 : 0);
     }
-    rec.fit = post::FitJkSweep(used);
+    // Per repeat: the repeats at every speed (not those that only the speeds of
+    // breakage.crossing_velocities have).
+    std::vector<post::SweepPoint> speeds;
+    for (const auto* s : list) speeds.push_back({s->velocity_m_s, s->repeat, 0.0});
+    const std::set<int> whole = post::RepeatsAtEveryVelocity(speeds);
+    rec.fit = post::FitJkSweep(used, &whole);
     const post::JkFit& f = rec.fit.pooled;
     std::string reason = f.reason;
     if (used.empty())
