@@ -1,6 +1,8 @@
 // The engine runner: failures surface log and status; signals reach children.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -43,6 +45,30 @@ TEST(Runner, SuccessReturnsZeroAndWritesLog) {
   std::string line;
   std::getline(in, line);
   EXPECT_EQ(line, "hello from child");
+}
+
+// An engine gets stdin, stdout and stderr only: a file this process has open
+// (without O_CLOEXEC, as HDF5 opens its files, locked with flock) is not
+// open in the engine, so the engine cannot hold that file's lock.
+TEST(Runner, EngineInheritsNoOpenFileOfOrchestrate) {
+  const auto d = fresh_dir("fds");
+  const int fd = ::open((d.path() / "held.h5").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(flock(fd, LOCK_EX), 0);
+  Runner r;
+  // And under no other number: what each of the shell's descriptors names.
+  auto res = r.run(sh(d, "if [ -e /proc/$$/fd/" + std::to_string(fd) +
+                             " ]; then echo inherited; else echo closed; fi; "
+                             "for f in /proc/$$/fd/*; do readlink $f; done; true"));
+  EXPECT_EQ(res.exit_code, 0);
+  std::ifstream in(d.path() / "log.txt");
+  std::string line, targets;
+  std::getline(in, line);
+  for (std::string t; std::getline(in, t);) targets += t + "\n";
+  EXPECT_EQ(line, "closed") << targets;
+  EXPECT_EQ(targets.find("held.h5"), std::string::npos) << targets;
+  EXPECT_NE(targets.find("log.txt"), std::string::npos) << targets;  // stdout: the listing works
+  ::close(fd);
 }
 
 TEST(Runner, FailingChildSurfacesLogPathAndExitStatus) {
