@@ -695,12 +695,16 @@ void check_job_count(const Document& d) {
     const double nv = static_cast<double>(d.reals("breakage.velocities").size());
     const double na = static_cast<double>(d.reals("breakage.angles").size());
     jobs = nv * na * repeats;
-    if (d.has("breakage.crossing_velocities"))  // (only sweep speeds: checked before)
-      jobs += static_cast<double>(d.reals("breakage.crossing_velocities").size()) * na *
-              static_cast<double>(d.integer("breakage.crossing_repeats") -
-                                  d.integer("breakage.repeats"));
     how = fmt::format("breakage.velocities ({}) x breakage.angles ({}) x breakage.repeats ({})", nv, na, repeats);
     factors = {{"breakage.velocities", nv}, {"breakage.angles", na}, {"breakage.repeats", repeats}};
+    if (d.has("breakage.crossing_velocities")) {  // (only sweep speeds: checked before)
+      const double nc = static_cast<double>(d.reals("breakage.crossing_velocities").size());
+      const double more = static_cast<double>(d.integer("breakage.crossing_repeats")) - repeats;
+      jobs += nc * na * more;
+      how += fmt::format(" + breakage.crossing_velocities ({}) x breakage.angles x {} more repeats",
+                         nc, more);
+      factors.push_back({"breakage.crossing_repeats", more});
+    }
   } else {
     const double bins = static_cast<double>(d.integer("breakage.velocity_bins"));
     const double lumps = static_cast<double>(d.integer("breakage.in_mill.lumps"));
